@@ -1,0 +1,92 @@
+#pragma once
+// A thin RAII layer over the HDF5 C API for the project's files (body models,
+// avatars, simulation results). Every read checks the dataset exists, has the
+// expected rank/shape and (for floating data) is finite, and throws
+// sflsh::Error naming the file and dataset otherwise. HDF5's own error stack
+// printing is silenced; its failures become sflsh::Error too.
+//
+// Writing goes to "<path>.partial" and is renamed over <path> by commit(), so a
+// failed or interrupted job never leaves a half-written file behind.
+#include <cstdint>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "sflsh/core/types.hpp"
+
+namespace sflsh::io {
+
+class Hdf5File {
+ public:
+  enum class Mode { Read, Write };
+  /// Opens `path` for reading, or creates `<path>.partial` for writing.
+  Hdf5File(const std::string& path, Mode mode);
+  ~Hdf5File();  // Write mode without commit(): removes the partial file.
+  Hdf5File(const Hdf5File&) = delete;
+  Hdf5File& operator=(const Hdf5File&) = delete;
+
+  /// Write mode: closes the file and renames it to its final path.
+  void commit();
+
+  const std::string& path() const { return path_; }
+  bool has(const std::string& name) const;  // dataset or group, e.g. "/tet/nodes"
+  /// Shape of a dataset (throws if missing).
+  std::vector<std::int64_t> shape(const std::string& name) const;
+
+  // --- writing (intermediate groups are created) ---
+  /// Row-major 2-D array (rows x cols). `as_float32` stores single precision.
+  void write(const std::string& name, const double* data, std::int64_t rows, std::int64_t cols,
+             bool as_float32 = false);
+  void write(const std::string& name, const int* data, std::int64_t rows, std::int64_t cols);
+  /// N-D array of doubles with an explicit shape (row-major).
+  void write_nd(const std::string& name, const double* data, const std::vector<std::int64_t>& shape,
+                bool as_float32 = false);
+  void write_nd(const std::string& name, const int* data, const std::vector<std::int64_t>& shape);
+  void write_strings(const std::string& name, const std::vector<std::string>& values);
+  void write_string(const std::string& name, const std::string& value);  // scalar string dataset
+  void write_scalar(const std::string& name, double value);
+  void write_scalar(const std::string& name, std::int64_t value);
+
+  template <class Derived>
+  void write_matrix(const std::string& name, const Eigen::DenseBase<Derived>& m, bool as_float32 = false) {
+    using S = typename Derived::Scalar;
+    Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> r = m;
+    if constexpr (std::is_integral_v<S>) {
+      Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> ri = r.template cast<int>();
+      write(name, ri.data(), ri.rows(), ri.cols());
+    } else {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rd = r.template cast<double>();
+      write(name, rd.data(), rd.rows(), rd.cols(), as_float32);
+    }
+  }
+
+  // --- reading ---
+  /// Reads a 1-D or 2-D numeric dataset as doubles (rank-1 -> n x 1).
+  /// `rows`/`cols` of -1 accept any extent; otherwise a mismatch throws
+  /// "FILE: dataset NAME has shape (a, b), expected (rows, cols)". Non-finite
+  /// values throw naming the dataset and the first bad index.
+  MatXr read_matrix(const std::string& name, std::int64_t rows = -1, std::int64_t cols = -1) const;
+  Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> read_int_matrix(
+      const std::string& name, std::int64_t rows = -1, std::int64_t cols = -1) const;
+  /// N-D doubles; `expected` entries of -1 are free. Fills `shape_out`.
+  std::vector<double> read_nd(const std::string& name, const std::vector<std::int64_t>& expected,
+                              std::vector<std::int64_t>* shape_out = nullptr) const;
+  std::vector<std::string> read_strings(const std::string& name) const;
+  std::string read_string(const std::string& name) const;
+  double read_scalar(const std::string& name) const;
+
+  template <class M>
+  M read_as(const std::string& name, std::int64_t rows = -1, std::int64_t cols = -1) const {
+    return read_matrix(name, rows, cols).template cast<typename M::Scalar>();
+  }
+
+ private:
+  long open_dataset(const std::string& name) const;  // hid_t
+  void ensure_parent_groups(const std::string& name);
+  std::string path_, write_path_;
+  Mode mode_;
+  long file_ = -1;  // hid_t
+  bool committed_ = false;
+};
+
+}  // namespace sflsh::io

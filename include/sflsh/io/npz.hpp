@@ -1,0 +1,39 @@
+#pragma once
+// numpy .npy / .npz reading and writing (the format numpy documents in
+// numpy.lib.format: magic "\x93NUMPY", version, a header dict with 'descr',
+// 'fortran_order', 'shape'; .npz is a zip of such files, stored or deflated).
+// Reads little-endian float16/32/64, (u)int8..64 and bool; values are converted
+// to double. Every failure throws sflsh::Error naming the file and key.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace sflsh::io {
+
+struct NpyArray {
+  std::vector<std::int64_t> shape;  ///< numpy shape (C order after reading)
+  std::string dtype;                ///< numpy descr as stored, e.g. "<f4"
+  std::vector<double> data;         ///< values in C (row-major) order
+  std::int64_t size() const;
+  /// Throws "<where>: key '<key>' has shape (..), expected (..)" on mismatch;
+  /// -1 entries of `expected` are free.
+  void require_shape(const std::vector<std::int64_t>& expected, const std::string& where,
+                     const std::string& key) const;
+  /// Throws naming where/key and the flat index of the first NaN/Inf.
+  void require_finite(const std::string& where, const std::string& key) const;
+};
+
+/// All arrays of an .npz file, by key (without the ".npy" suffix). Entries that
+/// are not numeric (object arrays, strings) are skipped unless `strings`
+/// is given, where unicode/bytes arrays are collected instead.
+std::map<std::string, NpyArray> read_npz(const std::string& path,
+                                         std::map<std::string, std::vector<std::string>>* strings = nullptr);
+/// One .npy file.
+NpyArray read_npy(const std::string& path);
+
+/// Writes an .npz (float64 arrays unless the array's dtype says "<f4", "<i4"
+/// or "<i8"), deflated when `compressed`. Atomic (temp file + rename).
+void write_npz(const std::string& path, const std::map<std::string, NpyArray>& arrays, bool compressed = false);
+
+}  // namespace sflsh::io

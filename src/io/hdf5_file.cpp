@@ -1,0 +1,276 @@
+#include "sflsh/io/hdf5_file.hpp"
+
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "sflsh/core/error.hpp"
+
+namespace sflsh::io {
+namespace {
+
+// HDF5 prints its error stack to stderr by default; we report our own errors.
+struct SilenceHdf5 {
+  SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+};
+const SilenceHdf5 g_silence;
+
+// Closes an hid_t with the matching H5*close on scope exit.
+struct Handle {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  Handle(hid_t i, herr_t (*c)(hid_t)) : id(i), close(c) {}
+  ~Handle() {
+    if (id >= 0) close(id);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+};
+
+std::string shape_str(const std::vector<std::int64_t>& s) {
+  std::ostringstream os;
+  os << "(";
+  for (size_t i = 0; i < s.size(); ++i) os << (i ? ", " : "") << (s[i] < 0 ? std::string("*") : std::to_string(s[i]));
+  if (s.size() == 1) os << ",";
+  os << ")";
+  return os.str();
+}
+
+}  // namespace
+
+Hdf5File::Hdf5File(const std::string& path, Mode mode) : path_(path), mode_(mode) {
+  if (mode == Mode::Read) {
+    if (!std::filesystem::exists(path)) fail(path, ": file not found");
+    if (H5Fis_hdf5(path.c_str()) <= 0) fail(path, ": not an HDF5 file (or truncated/corrupted)");
+    file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (file_ < 0) fail(path, ": cannot open HDF5 file (truncated or corrupted?)");
+  } else {
+    write_path_ = path + ".partial";
+    auto parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty() && !std::filesystem::exists(parent)) fail(path, ": output folder ", parent.string(), " does not exist");
+    file_ = H5Fcreate(write_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (file_ < 0) fail(path, ": cannot create file");
+  }
+}
+
+Hdf5File::~Hdf5File() {
+  if (file_ >= 0) H5Fclose(file_);
+  if (mode_ == Mode::Write && !committed_) {
+    std::error_code ec;
+    std::filesystem::remove(write_path_, ec);
+  }
+}
+
+void Hdf5File::commit() {
+  require(mode_ == Mode::Write, path_, ": commit() on a file opened for reading");
+  if (H5Fclose(file_) < 0) fail(path_, ": failed to flush/close");
+  file_ = -1;
+  std::error_code ec;
+  std::filesystem::rename(write_path_, path_, ec);
+  if (ec) fail(path_, ": cannot rename ", write_path_, " into place: ", ec.message());
+  committed_ = true;
+}
+
+bool Hdf5File::has(const std::string& name) const {
+  // Check each path component so a missing intermediate group is not an error.
+  std::string partial;
+  std::stringstream ss(name);
+  std::string comp;
+  while (std::getline(ss, comp, '/')) {
+    if (comp.empty()) continue;
+    partial += "/" + comp;
+    if (H5Lexists(file_, partial.c_str(), H5P_DEFAULT) <= 0) return false;
+  }
+  return !partial.empty();
+}
+
+long Hdf5File::open_dataset(const std::string& name) const {
+  if (!has(name)) fail(path_, ": dataset ", name, " is missing");
+  hid_t ds = H5Dopen2(file_, name.c_str(), H5P_DEFAULT);
+  if (ds < 0) fail(path_, ": ", name, " is not a readable dataset");
+  return ds;
+}
+
+std::vector<std::int64_t> Hdf5File::shape(const std::string& name) const {
+  Handle ds(open_dataset(name), H5Dclose);
+  Handle sp(H5Dget_space(ds.id), H5Sclose);
+  int rank = H5Sget_simple_extent_ndims(sp.id);
+  if (rank < 0) fail(path_, ": dataset ", name, " has an unreadable shape");
+  std::vector<hsize_t> dims(rank);
+  H5Sget_simple_extent_dims(sp.id, dims.data(), nullptr);
+  return std::vector<std::int64_t>(dims.begin(), dims.end());
+}
+
+void Hdf5File::ensure_parent_groups(const std::string& name) {
+  size_t pos = 0;
+  while ((pos = name.find('/', pos + 1)) != std::string::npos) {
+    std::string g = name.substr(0, pos);
+    if (H5Lexists(file_, g.c_str(), H5P_DEFAULT) <= 0) {
+      hid_t gid = H5Gcreate2(file_, g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      if (gid < 0) fail(path_, ": cannot create group ", g);
+      H5Gclose(gid);
+    }
+  }
+}
+
+namespace {
+void write_raw(hid_t file, const std::string& path, const std::string& name, const void* data,
+               const std::vector<std::int64_t>& shape, hid_t mem_type, hid_t file_type) {
+  std::vector<hsize_t> dims(shape.begin(), shape.end());
+  Handle sp(H5Screate_simple(int(dims.size()), dims.data(), nullptr), H5Sclose);
+  // Compress large datasets (chunked, deflate level 4): avatars carry big matrices.
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  hsize_t total = 1;
+  for (auto d : dims) total *= d;
+  if (total >= 4096 && !dims.empty()) {
+    std::vector<hsize_t> chunk(dims);
+    // Chunk along the first axis, about 64k elements per chunk.
+    hsize_t row = total / (dims[0] ? dims[0] : 1);
+    chunk[0] = std::max<hsize_t>(1, std::min<hsize_t>(dims[0], 65536 / std::max<hsize_t>(row, 1)));
+    H5Pset_chunk(dcpl.id, int(chunk.size()), chunk.data());
+    H5Pset_deflate(dcpl.id, 4);
+  }
+  Handle ds(H5Dcreate2(file, name.c_str(), file_type, sp.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), H5Dclose);
+  if (ds.id < 0) fail(path, ": cannot create dataset ", name, " (exists already?)");
+  if (total > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    fail(path, ": cannot write dataset ", name);
+}
+}  // namespace
+
+void Hdf5File::write_nd(const std::string& name, const double* data, const std::vector<std::int64_t>& shape,
+                        bool as_float32) {
+  require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
+  ensure_parent_groups(name);
+  write_raw(file_, path_, name, data, shape, H5T_NATIVE_DOUBLE, as_float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE);
+}
+
+void Hdf5File::write_nd(const std::string& name, const int* data, const std::vector<std::int64_t>& shape) {
+  require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
+  ensure_parent_groups(name);
+  write_raw(file_, path_, name, data, shape, H5T_NATIVE_INT, H5T_STD_I32LE);
+}
+
+void Hdf5File::write(const std::string& name, const double* data, std::int64_t rows, std::int64_t cols,
+                     bool as_float32) {
+  write_nd(name, data, {rows, cols}, as_float32);
+}
+
+void Hdf5File::write(const std::string& name, const int* data, std::int64_t rows, std::int64_t cols) {
+  write_nd(name, data, {rows, cols});
+}
+
+void Hdf5File::write_scalar(const std::string& name, double value) { write_nd(name, &value, {1}); }
+
+void Hdf5File::write_scalar(const std::string& name, std::int64_t value) {
+  require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
+  ensure_parent_groups(name);
+  write_raw(file_, path_, name, &value, {1}, H5T_NATIVE_INT64, H5T_STD_I64LE);
+}
+
+void Hdf5File::write_strings(const std::string& name, const std::vector<std::string>& values) {
+  require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
+  ensure_parent_groups(name);
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.id, H5T_VARIABLE);
+  H5Tset_cset(type.id, H5T_CSET_UTF8);
+  std::vector<const char*> ptrs;
+  for (auto& v : values) ptrs.push_back(v.c_str());
+  hsize_t n = values.size();
+  Handle sp(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  Handle ds(H5Dcreate2(file_, name.c_str(), type.id, sp.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  if (ds.id < 0) fail(path_, ": cannot create dataset ", name);
+  if (n > 0 && H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) < 0)
+    fail(path_, ": cannot write dataset ", name);
+}
+
+void Hdf5File::write_string(const std::string& name, const std::string& value) {
+  write_strings(name, {value});
+}
+
+std::vector<std::string> Hdf5File::read_strings(const std::string& name) const {
+  Handle ds(open_dataset(name), H5Dclose);
+  Handle ftype(H5Dget_type(ds.id), H5Tclose);
+  if (H5Tget_class(ftype.id) != H5T_STRING) fail(path_, ": dataset ", name, " is not a string dataset");
+  Handle sp(H5Dget_space(ds.id), H5Sclose);
+  hssize_t n = H5Sget_simple_extent_npoints(sp.id);
+  std::vector<std::string> out;
+  if (H5Tis_variable_str(ftype.id) > 0) {
+    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mtype.id, H5T_VARIABLE);
+    H5Tset_cset(mtype.id, H5Tget_cset(ftype.id));  // HDF5 does not convert ASCII <-> UTF-8
+    std::vector<char*> buf(n, nullptr);
+    if (n > 0 && H5Dread(ds.id, mtype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
+      fail(path_, ": cannot read dataset ", name);
+    for (auto* p : buf) out.emplace_back(p ? p : "");
+    if (n > 0) H5Dvlen_reclaim(mtype.id, sp.id, H5P_DEFAULT, buf.data());
+  } else {
+    size_t sz = H5Tget_size(ftype.id);
+    std::vector<char> buf(sz * n + 1, 0);
+    if (n > 0 && H5Dread(ds.id, ftype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
+      fail(path_, ": cannot read dataset ", name);
+    for (hssize_t i = 0; i < n; ++i) {
+      std::string s(buf.data() + i * sz, sz);
+      out.emplace_back(s.c_str());
+    }
+  }
+  return out;
+}
+
+std::string Hdf5File::read_string(const std::string& name) const {
+  auto v = read_strings(name);
+  if (v.size() != 1) fail(path_, ": dataset ", name, " holds ", v.size(), " strings, expected 1");
+  return v[0];
+}
+
+std::vector<double> Hdf5File::read_nd(const std::string& name, const std::vector<std::int64_t>& expected,
+                                      std::vector<std::int64_t>* shape_out) const {
+  Handle ds(open_dataset(name), H5Dclose);
+  Handle ftype(H5Dget_type(ds.id), H5Tclose);
+  auto cls = H5Tget_class(ftype.id);
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER) fail(path_, ": dataset ", name, " is not numeric");
+  auto s = shape(name);
+  bool ok = expected.empty() || s.size() == expected.size();
+  for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] < 0 || expected[i] == s[i];
+  if (!ok) fail(path_, ": dataset ", name, " has shape ", shape_str(s), ", expected ", shape_str(expected));
+  std::int64_t n = 1;
+  for (auto d : s) n *= d;
+  std::vector<double> buf(n);
+  if (n > 0 && H5Dread(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
+    fail(path_, ": cannot read dataset ", name, " (truncated or corrupted file?)");
+  for (std::int64_t i = 0; i < n; ++i)
+    if (!std::isfinite(buf[i])) fail(path_, ": dataset ", name, " holds a non-finite value at flat index ", i);
+  if (shape_out) *shape_out = s;
+  return buf;
+}
+
+MatXr Hdf5File::read_matrix(const std::string& name, std::int64_t rows, std::int64_t cols) const {
+  auto s = shape(name);
+  if (s.size() == 1) s.push_back(1);
+  if (s.size() != 2) fail(path_, ": dataset ", name, " has rank ", s.size(), ", expected a matrix ", shape_str({rows, cols}));
+  if ((rows >= 0 && s[0] != rows) || (cols >= 0 && s[1] != cols))
+    fail(path_, ": dataset ", name, " has shape ", shape_str(s), ", expected ", shape_str({rows, cols}));
+  auto buf = read_nd(name, {});
+  MatXr m(s[0], s[1]);
+  std::copy(buf.begin(), buf.end(), m.data());
+  return m;
+}
+
+Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Hdf5File::read_int_matrix(
+    const std::string& name, std::int64_t rows, std::int64_t cols) const {
+  MatXr m = read_matrix(name, rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    if (m.data()[i] != std::floor(m.data()[i]) || std::abs(m.data()[i]) > 2e9)
+      fail(path_, ": dataset ", name, " holds a non-integer value at flat index ", i);
+  return m.cast<int>();
+}
+
+double Hdf5File::read_scalar(const std::string& name) const {
+  auto v = read_nd(name, {});
+  if (v.size() != 1) fail(path_, ": dataset ", name, " holds ", v.size(), " values, expected a scalar");
+  return v[0];
+}
+
+}  // namespace sflsh::io

@@ -1,0 +1,31 @@
+#pragma once
+// Helpers shared by the test executables.
+#include <filesystem>
+#include <string>
+
+namespace sflsh::test {
+
+/// A fresh, empty temporary folder for this test (removed at exit of the test).
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  const std::filesystem::path& path() const { return path_; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Path of ../shared/data/<rel> or "" when the shared folder is absent
+/// (tests then GTEST_SKIP() with a message saying so).
+std::string shared_data(const std::string& rel);
+
+/// The repository's source folder and the built sflsh executable.
+std::string source_dir();
+std::string sflsh_binary();
+
+/// Runs a shell command, returns its exit code; stdout+stderr go to *output.
+int run_command(const std::string& cmd, std::string* output = nullptr);
+
+}  // namespace sflsh::test
