@@ -1,0 +1,33 @@
+#pragma once
+// Writing a file so that readers never see a half-written one: the data goes
+// to "<path>.partial" next to the target (same file system) and is renamed
+// over <path> by commit(). Without commit() (an exception, an early return)
+// the partial file is removed, so a failed job leaves nothing behind.
+#include <string>
+
+namespace sflsh::io {
+
+class AtomicOutput {
+ public:
+  /// Prepares to write `path`; creates missing parent folders.
+  explicit AtomicOutput(std::string path);
+  ~AtomicOutput();  ///< Removes the partial file unless committed.
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  /// Where to write the data ("<path>.partial").
+  const std::string& temp_path() const { return temp_path_; }
+  /// The final path.
+  const std::string& path() const { return path_; }
+  /// Renames the partial file over the final path (throws if it is missing).
+  void commit();
+
+ private:
+  std::string path_, temp_path_;
+  bool committed_ = false;
+};
+
+/// Lower-case extension of `path` including the dot (".obj"), "" if none.
+std::string lower_extension(const std::string& path);
+
+}  // namespace sflsh::io

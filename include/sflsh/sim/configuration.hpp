@@ -1,0 +1,42 @@
+#pragma once
+// The simulation's degrees of freedom q = ({G_i} bone rigid transforms, z)
+// (seed §3–4) and how a tangent-space step is laid out and applied.
+//
+// Bone transform G_i maps unposed (shaped, rest-pose) points to world:
+//   x_world = R_i x̄ + t_i   (SMPL's per-joint A matrices / joint_world_transforms).
+// Tangent step for bone i: ξ_i = (ω_i, v_i) ∈ R^6, applied on the left, in world
+// coordinates: R_i ← exp(ω_i) R_i,  t_i ← exp(ω_i) t_i + v_i.
+// So at ξ = 0:  ∂x/∂ω_i = −[x]×,  ∂x/∂v_i = I   for x = G_i x̄.
+// Reduced soft DoFs z ∈ R^{3K}: z[3k..3k+2] = displacement of handle k (m, unposed).
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sflsh/core/types.hpp"
+
+namespace sflsh {
+
+using Isometry = Eigen::Isometry3d;
+
+/// A configuration q of the whole avatar.
+struct Configuration {
+  std::vector<Isometry> bones;  ///< 24 world transforms G_i
+  VecX z;                       ///< 3K reduced soft DoFs
+};
+
+/// Which DoFs the Newton step solves for, and where they sit in the step vector.
+struct DofLayout {
+  int num_bones = 24;          ///< bones in the configuration
+  bool bones_dynamic = true;   ///< false: bones prescribed (kinematic), only z is solved
+  int num_reduced = 0;         ///< 3K
+
+  int bone_offset(int i) const { return 6 * i; }      ///< valid only if bones_dynamic
+  int z_offset() const { return bones_dynamic ? 6 * num_bones : 0; }
+  int size() const { return z_offset() + num_reduced; }
+};
+
+/// Applies a tangent step `delta` (layout.size()) to `q`: bones by the
+/// exponential map (left, world frame), z additively.
+Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout);
+
+}  // namespace sflsh

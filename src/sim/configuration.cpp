@@ -1,0 +1,24 @@
+#include "sflsh/sim/configuration.hpp"
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
+
+namespace sflsh {
+
+Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout) {
+  require(delta.size() == layout.size(), "retract: step has ", delta.size(), " entries, expected ", layout.size());
+  Configuration out = q;
+  if (layout.bones_dynamic) {
+    for (int i = 0; i < layout.num_bones; ++i) {
+      const Vec3 w = delta.segment<3>(layout.bone_offset(i));
+      const Vec3 v = delta.segment<3>(layout.bone_offset(i) + 3);
+      const Mat3 E = rodrigues(w);
+      out.bones[i].linear() = E * q.bones[i].linear();
+      out.bones[i].translation() = E * q.bones[i].translation() + v;
+    }
+  }
+  out.z = q.z + delta.segment(layout.z_offset(), layout.num_reduced);
+  return out;
+}
+
+}  // namespace sflsh
