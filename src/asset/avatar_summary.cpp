@@ -1,0 +1,122 @@
+#include "sflsh/asset/avatar_summary.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace sflsh {
+namespace {
+
+// Smallest of the six dihedral angles of tet (a, b, c, d), degrees.
+double min_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 p[4] = {a, b, c, d};
+  // Face normals opposite each vertex; the dihedral at edge (i,j) is pi − angle(n_k, n_l).
+  Vec3 n[4];
+  for (int i = 0; i < 4; ++i) {
+    const Vec3& q0 = p[(i + 1) % 4];
+    const Vec3& q1 = p[(i + 2) % 4];
+    const Vec3& q2 = p[(i + 3) % 4];
+    n[i] = (q1 - q0).cross(q2 - q0).normalized();
+    if (n[i].dot(p[i] - q0) > 0) n[i] = -n[i];  // outward
+  }
+  double best = 180.0;
+  for (int k = 0; k < 4; ++k)
+    for (int l = k + 1; l < 4; ++l) {
+      const double cosang = std::clamp(-n[k].dot(n[l]), -1.0, 1.0);
+      best = std::min(best, std::acos(cosang) * 180.0 / M_PI);
+    }
+  return best;
+}
+
+}  // namespace
+
+AvatarSummary summarize_avatar(const Avatar& a) {
+  AvatarSummary s;
+  s.surface_vertices = int(a.surface_rest.rows());
+  s.surface_faces = int(a.surface_faces.rows());
+  s.joints = int(a.joints_rest.rows());
+  s.tet_nodes = a.tet.num_nodes();
+  s.tets = a.tet.num_elements();
+  for (Eigen::Index i = 0; i < a.node_role.size(); ++i) {
+    const auto r = NodeRole(a.node_role[i]);
+    (r == NodeRole::Simulated ? s.simulated_nodes : r == NodeRole::Skinned ? s.skinned_nodes : s.bone_nodes)++;
+  }
+  s.handles = a.num_handles();
+  s.elastic_samples = a.elastic.size();
+  s.inertia_samples = a.inertia.size();
+  s.regions = int(a.materials.size());
+  s.basis_nonzeros = a.W.nonZeros();
+  s.min_tet_volume_m3 = INFINITY;
+  s.min_dihedral_deg = 180.0;
+  for (int t = 0; t < s.tets; ++t) {
+    const Vec3 x0 = a.tet.nodes.row(a.tet.elements(t, 0)), x1 = a.tet.nodes.row(a.tet.elements(t, 1)),
+               x2 = a.tet.nodes.row(a.tet.elements(t, 2)), x3 = a.tet.nodes.row(a.tet.elements(t, 3));
+    const double v = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+    s.volume_m3 += v;
+    s.mass_kg += v * a.materials[a.tet_region[t]].density;
+    s.min_tet_volume_m3 = std::min(s.min_tet_volume_m3, v);
+    s.min_dihedral_deg = std::min(s.min_dihedral_deg, min_dihedral(x0, x1, x2, x3));
+  }
+  s.elastic_volume_m3 = a.elastic.weights.sum();
+  s.inertia_volume_m3 = a.inertia.weights.sum();
+  for (int i = 0; i < a.inertia.size(); ++i)
+    s.inertia_mass_kg += a.inertia.weights[i] * a.materials[a.tet_region[a.inertia.elements[i]]].density;
+  VecX row_sums = a.W * VecX::Ones(a.W.cols());
+  s.max_partition_error = row_sums.size() ? std::max(0.0, row_sums.maxCoeff() - 1.0) : 0.0;
+  if (a.W.nonZeros() > 0) {
+    s.min_weight = INFINITY;
+    s.max_weight = -INFINITY;
+    for (int k = 0; k < a.W.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, k); it; ++it) {
+        s.min_weight = std::min(s.min_weight, it.value());
+        s.max_weight = std::max(s.max_weight, it.value());
+      }
+  }
+  s.height_m = a.surface_rest.col(1).maxCoeff() - a.surface_rest.col(1).minCoeff();
+  std::ostringstream b;
+  for (Eigen::Index i = 0; i < a.betas.size(); ++i) b << (i ? "," : "") << a.betas[i];
+  s.betas = b.str();
+  s.model_source = a.model_source;
+  s.model_hash = a.model_hash;
+  return s;
+}
+
+std::string AvatarSummary::to_text(const std::string& title) const {
+  std::ostringstream o;
+  o << std::setprecision(4);
+  o << title << "\n"
+    << "  body model        " << model_source << " (hash " << model_hash << "), betas [" << betas << "]\n"
+    << "  surface           " << surface_vertices << " vertices, " << surface_faces << " faces, height " << height_m << " m\n"
+    << "  skeleton          " << joints << " joints\n"
+    << "  tet mesh          " << tet_nodes << " nodes (" << simulated_nodes << " simulated, " << skinned_nodes
+    << " skinned only, " << bone_nodes << " bone), " << tets << " tets\n"
+    << "  tet quality       min dihedral " << min_dihedral_deg << " deg, min volume " << min_tet_volume_m3 << " m^3\n"
+    << "  volume / mass     " << volume_m3 << " m^3, " << mass_kg << " kg, " << regions << " material regions\n"
+    << "  basis             " << handles << " handles (" << 3 * handles << " reduced DoFs), " << basis_nonzeros
+    << " non-zero weights in [" << min_weight << ", " << max_weight << "], max sum excess " << max_partition_error << "\n"
+    << "  cubature          elastic " << elastic_samples << " samples (volume " << elastic_volume_m3 << " m^3), inertia "
+    << inertia_samples << " samples (volume " << inertia_volume_m3 << " m^3, mass " << inertia_mass_kg << " kg)\n";
+  return o.str();
+}
+
+std::string AvatarSummary::to_json() const {
+  std::ostringstream o;
+  o << std::setprecision(10) << "{\n"
+    << "  \"model_source\": \"" << model_source << "\",\n  \"model_hash\": \"" << model_hash << "\",\n"
+    << "  \"betas\": [" << betas << "],\n"
+    << "  \"surface_vertices\": " << surface_vertices << ",\n  \"surface_faces\": " << surface_faces << ",\n"
+    << "  \"joints\": " << joints << ",\n  \"tet_nodes\": " << tet_nodes << ",\n  \"tets\": " << tets << ",\n"
+    << "  \"simulated_nodes\": " << simulated_nodes << ",\n  \"skinned_nodes\": " << skinned_nodes << ",\n"
+    << "  \"bone_nodes\": " << bone_nodes << ",\n  \"handles\": " << handles << ",\n"
+    << "  \"basis_nonzeros\": " << basis_nonzeros << ",\n  \"elastic_samples\": " << elastic_samples << ",\n"
+    << "  \"inertia_samples\": " << inertia_samples << ",\n  \"regions\": " << regions << ",\n"
+    << "  \"volume_m3\": " << volume_m3 << ",\n  \"mass_kg\": " << mass_kg << ",\n"
+    << "  \"min_tet_volume_m3\": " << min_tet_volume_m3 << ",\n  \"min_dihedral_deg\": " << min_dihedral_deg << ",\n"
+    << "  \"elastic_volume_m3\": " << elastic_volume_m3 << ",\n  \"inertia_volume_m3\": " << inertia_volume_m3 << ",\n"
+    << "  \"inertia_mass_kg\": " << inertia_mass_kg << ",\n  \"max_partition_error\": " << max_partition_error << ",\n"
+    << "  \"min_weight\": " << min_weight << ",\n  \"max_weight\": " << max_weight << ",\n"
+    << "  \"height_m\": " << height_m << "\n}\n";
+  return o.str();
+}
+
+}  // namespace sflsh
