@@ -4,31 +4,9 @@
 #include <iomanip>
 #include <sstream>
 
+#include "sflsh/mesh/tet_quality.hpp"
+
 namespace sflsh {
-namespace {
-
-// Smallest of the six dihedral angles of tet (a, b, c, d), degrees.
-double min_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const Vec3 p[4] = {a, b, c, d};
-  // Face normals opposite each vertex; the dihedral at edge (i,j) is pi − angle(n_k, n_l).
-  Vec3 n[4];
-  for (int i = 0; i < 4; ++i) {
-    const Vec3& q0 = p[(i + 1) % 4];
-    const Vec3& q1 = p[(i + 2) % 4];
-    const Vec3& q2 = p[(i + 3) % 4];
-    n[i] = (q1 - q0).cross(q2 - q0).normalized();
-    if (n[i].dot(p[i] - q0) > 0) n[i] = -n[i];  // outward
-  }
-  double best = 180.0;
-  for (int k = 0; k < 4; ++k)
-    for (int l = k + 1; l < 4; ++l) {
-      const double cosang = std::clamp(-n[k].dot(n[l]), -1.0, 1.0);
-      best = std::min(best, std::acos(cosang) * 180.0 / M_PI);
-    }
-  return best;
-}
-
-}  // namespace
 
 AvatarSummary summarize_avatar(const Avatar& a) {
   AvatarSummary s;
@@ -46,16 +24,14 @@ AvatarSummary summarize_avatar(const Avatar& a) {
   s.inertia_samples = a.inertia.size();
   s.regions = int(a.materials.size());
   s.basis_nonzeros = a.W.nonZeros();
-  s.min_tet_volume_m3 = INFINITY;
-  s.min_dihedral_deg = 180.0;
+  const TetQualityReport q = tet_quality_report(a.tet);
+  s.volume_m3 = q.total_volume;
+  s.min_tet_volume_m3 = q.min_volume;
+  s.min_dihedral_deg = q.min_dihedral_deg;
   for (int t = 0; t < s.tets; ++t) {
     const Vec3 x0 = a.tet.nodes.row(a.tet.elements(t, 0)), x1 = a.tet.nodes.row(a.tet.elements(t, 1)),
                x2 = a.tet.nodes.row(a.tet.elements(t, 2)), x3 = a.tet.nodes.row(a.tet.elements(t, 3));
-    const double v = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
-    s.volume_m3 += v;
-    s.mass_kg += v * a.materials[a.tet_region[t]].density;
-    s.min_tet_volume_m3 = std::min(s.min_tet_volume_m3, v);
-    s.min_dihedral_deg = std::min(s.min_dihedral_deg, min_dihedral(x0, x1, x2, x3));
+    s.mass_kg += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0 * a.materials[a.tet_region[t]].density;
   }
   s.elastic_volume_m3 = a.elastic.weights.sum();
   s.inertia_volume_m3 = a.inertia.weights.sum();

@@ -162,6 +162,50 @@ void Hdf5File::write(const std::string& name, const int* data, std::int64_t rows
   write_nd(name, data, {rows, cols});
 }
 
+void Hdf5File::create_appendable(const std::string& name, const std::vector<std::int64_t>& row_shape,
+                                 bool as_float32) {
+  require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
+  ensure_parent_groups(name);
+  std::vector<hsize_t> dims{0}, maxdims{H5S_UNLIMITED}, chunk{1};
+  hsize_t row = 1;
+  for (auto d : row_shape) {
+    dims.push_back(hsize_t(d));
+    maxdims.push_back(hsize_t(d));
+    chunk.push_back(hsize_t(std::max<std::int64_t>(d, 1)));
+    row *= hsize_t(std::max<std::int64_t>(d, 1));
+  }
+  // Several rows per chunk when rows are small (scalars per frame).
+  chunk[0] = std::max<hsize_t>(1, 16384 / row);
+  Handle sp(H5Screate_simple(int(dims.size()), dims.data(), maxdims.data()), H5Sclose);
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_chunk(dcpl.id, int(chunk.size()), chunk.data());
+  H5Pset_deflate(dcpl.id, 4);
+  Handle ds(H5Dcreate2(file_, name.c_str(), as_float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE, sp.id, H5P_DEFAULT, dcpl.id,
+                       H5P_DEFAULT),
+            H5Dclose);
+  if (ds.id < 0) fail(path_, ": cannot create dataset ", name);
+}
+
+void Hdf5File::append(const std::string& name, const double* data, std::int64_t rows) {
+  require(mode_ == Mode::Write, path_, ": append on a file opened for reading");
+  Handle ds(H5Dopen2(file_, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (ds.id < 0) fail(path_, ": append to missing dataset ", name);
+  Handle sp(H5Dget_space(ds.id), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(sp.id);
+  std::vector<hsize_t> dims(rank);
+  H5Sget_simple_extent_dims(sp.id, dims.data(), nullptr);
+  std::vector<hsize_t> start(rank, 0), count(dims);
+  start[0] = dims[0];
+  count[0] = hsize_t(rows);
+  dims[0] += hsize_t(rows);
+  if (H5Dset_extent(ds.id, dims.data()) < 0) fail(path_, ": cannot extend dataset ", name);
+  Handle fsp(H5Dget_space(ds.id), H5Sclose);
+  H5Sselect_hyperslab(fsp.id, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  Handle msp(H5Screate_simple(rank, count.data(), nullptr), H5Sclose);
+  if (H5Dwrite(ds.id, H5T_NATIVE_DOUBLE, msp.id, fsp.id, H5P_DEFAULT, data) < 0)
+    fail(path_, ": cannot append to dataset ", name);
+}
+
 void Hdf5File::write_scalar(const std::string& name, double value) { write_nd(name, &value, {1}); }
 
 void Hdf5File::write_scalar(const std::string& name, std::int64_t value) {

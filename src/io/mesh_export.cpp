@@ -219,15 +219,18 @@ const std::vector<std::string>& mesh_export_extensions() {
   return exts;
 }
 
-void write_mesh(const std::string& path, const Points& V, const Triangles& F, const Points& colors) {
+void require_mesh_export_extension(const std::string& path, const std::string& what) {
   const std::string ext = lower_extension(path);
-  if (std::find(mesh_export_extensions().begin(), mesh_export_extensions().end(), ext) ==
-      mesh_export_extensions().end()) {
-    std::string list;
-    for (const auto& e : mesh_export_extensions()) list += (list.empty() ? "" : ", ") + e;
-    fail(path, ": unknown mesh format '", ext.empty() ? std::string("(no extension)") : ext,
-         "'; supported: ", list);
-  }
+  const auto& exts = mesh_export_extensions();
+  if (std::find(exts.begin(), exts.end(), ext) != exts.end()) return;
+  std::string list;
+  for (const auto& e : exts) list += (list.empty() ? "" : ", ") + e;
+  fail(what, ": unknown mesh format '", ext.empty() ? std::string("(no extension)") : ext, "'; supported: ", list);
+}
+
+void write_mesh(const std::string& path, const Points& V, const Triangles& F, const Points& colors) {
+  require_mesh_export_extension(path, path);
+  const std::string ext = lower_extension(path);
   validate(path, V, F, colors);
   if (ext == ".glb" || ext == ".gltf") {
     write_gltf(path, V, F, colors, ext == ".glb");

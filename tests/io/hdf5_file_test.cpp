@@ -96,3 +96,25 @@ TEST(Hdf5File, UncommittedWriteLeavesNoFile) {
   EXPECT_FALSE(std::filesystem::exists(path));
   EXPECT_FALSE(std::filesystem::exists(path + ".partial"));
 }
+
+TEST(Hdf5File, AppendableDatasetsGrowByRows) {
+  test::TempDir tmp;
+  const std::string path = tmp.file("s.h5");
+  {
+    Hdf5File f(path, Hdf5File::Mode::Write);
+    f.create_appendable("/frames/p", {4, 3}, true);
+    f.create_appendable("/frames/t", {});
+    for (int i = 0; i < 5; ++i) {
+      MatXr p = MatXr::Constant(4, 3, double(i));
+      f.append("/frames/p", p.data());
+      const double t = 0.5 * i;
+      f.append("/frames/t", &t);
+    }
+    f.commit();
+  }
+  Hdf5File f(path, Hdf5File::Mode::Read);
+  std::vector<std::int64_t> shape;
+  auto v = f.read_nd("/frames/p", {5, 4, 3}, &shape);
+  EXPECT_EQ(v[3 * 12 + 7], 3.0);
+  EXPECT_EQ(f.read_matrix("/frames/t", 5, 1)(4, 0), 2.0);
+}

@@ -19,7 +19,9 @@ struct BodyModel {
   /// Shape directions: shapedirs[b] is #V by 3 (B entries; B may be 0).
   std::vector<Points> shapedirs;
   /// Pose directions: #V*3 by 207, row 3*v+c, multiplying the pose feature
-  /// (flattened row-major (R_j - I) of joints 1..23). May be all zero.
+  /// (flattened row-major (R_j - I) of joints 1..23). May be all zero, or
+  /// empty (0 by 0) for "no pose blend shapes" (the readers store an all-zero
+  /// file array so; it keeps posing a zero-posedirs model fast).
   MatX posedirs;
   /// 24 by #V joint regressor (sparse): J = J_regressor * v_shaped.
   Eigen::SparseMatrix<double, Eigen::RowMajor> J_regressor;

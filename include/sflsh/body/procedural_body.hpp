@@ -18,4 +18,10 @@ struct ProceduralBodyOptions {
 /// arrays bit for bit. Takes well under a second.
 BodyModel make_procedural_body(const ProceduralBodyOptions& options = {});
 
+/// The joint positions (24 by 3, metres, SMPL order) that the procedural body
+/// is built around for shape coefficients `betas` (its parametric skeleton,
+/// before the shape space is linearized; missing entries are 0, at most 10).
+/// J_regressor · shape_vertices(model, betas) approximates them; exactly at β = 0.
+Points procedural_body_joints(const VecX& betas);
+
 }  // namespace sflsh

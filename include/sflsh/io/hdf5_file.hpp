@@ -47,6 +47,13 @@ class Hdf5File {
   void write_scalar(const std::string& name, double value);
   void write_scalar(const std::string& name, std::int64_t value);
 
+  /// Creates an empty dataset whose first axis grows with append(); each row
+  /// has shape `row_shape` (e.g. {V, 3} for per-frame positions).
+  void create_appendable(const std::string& name, const std::vector<std::int64_t>& row_shape, bool as_float32 = false);
+  /// Appends `rows` rows (row-major, rows × Π row_shape values) to a dataset
+  /// made by create_appendable (streams long outputs without holding them).
+  void append(const std::string& name, const double* data, std::int64_t rows = 1);
+
   template <class Derived>
   void write_matrix(const std::string& name, const Eigen::DenseBase<Derived>& m, bool as_float32 = false) {
     using S = typename Derived::Scalar;

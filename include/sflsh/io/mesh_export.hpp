@@ -19,6 +19,10 @@ namespace sflsh::io {
 /// The extensions write_mesh understands (".obj", ".ply", ".glb", ".gltf").
 const std::vector<std::string>& mesh_export_extensions();
 
+/// Throws "<what>: unknown mesh format '<ext>'; supported: .obj, ..." unless
+/// `path` ends in one of mesh_export_extensions() (case-insensitive).
+void require_mesh_export_extension(const std::string& path, const std::string& what);
+
 /// Writes the surface (V: #V by 3, F: #F by 3 0-based counter-clockwise) to
 /// `path`, format from the extension. `colors` is empty or #V by 3 RGB in
 /// [0, 1] (clamped). Throws sflsh::Error naming the path on an unknown

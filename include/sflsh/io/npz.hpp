@@ -2,8 +2,10 @@
 // numpy .npy / .npz reading and writing (the format numpy documents in
 // numpy.lib.format: magic "\x93NUMPY", version, a header dict with 'descr',
 // 'fortran_order', 'shape'; .npz is a zip of such files, stored or deflated).
-// Reads little-endian float16/32/64, (u)int8..64 and bool; values are converted
-// to double. Every failure throws sflsh::Error naming the file and key.
+// Reads float16/32/64, (u)int8..64 and bool in either byte order, C or Fortran
+// order (returned in C order); values are converted to double. Every failure
+// (truncated archive, malformed header, data shorter than the shape, ...)
+// throws sflsh::Error naming the file and key; sizes are bounds-checked.
 #include <cstdint>
 #include <map>
 #include <string>
@@ -24,11 +26,23 @@ struct NpyArray {
   void require_finite(const std::string& where, const std::string& key) const;
 };
 
+/// A shape as numpy prints it, "(20, 3)" or "(4,)"; -1 entries print as "any".
+std::string format_shape(const std::vector<std::int64_t>& shape);
+
 /// All arrays of an .npz file, by key (without the ".npy" suffix). Entries that
 /// are not numeric (object arrays, strings) are skipped unless `strings`
 /// is given, where unicode/bytes arrays are collected instead.
 std::map<std::string, NpyArray> read_npz(const std::string& path,
                                          std::map<std::string, std::vector<std::string>>* strings = nullptr);
+/// What an .npz entry holds (read from its .npy header), for diagnostics:
+/// lists every entry, including object and string arrays that read_npz skips.
+struct NpzEntryInfo {
+  std::string key;                  ///< entry name without ".npy"
+  std::string dtype;                ///< numpy descr, e.g. "<f4", "<U6", "|O"
+  std::vector<std::int64_t> shape;  ///< numpy shape
+};
+std::vector<NpzEntryInfo> list_npz(const std::string& path);
+
 /// One .npy file.
 NpyArray read_npy(const std::string& path);
 

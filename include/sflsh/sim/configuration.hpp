@@ -29,6 +29,14 @@ struct DofLayout {
   int num_bones = 24;          ///< bones in the configuration
   bool bones_dynamic = true;   ///< false: bones prescribed (kinematic), only z is solved
   int num_reduced = 0;         ///< 3K
+  /// Optional (added by sim2): #num_bones by 3 unposed pivots p̄_i (m), e.g. the
+  /// bones' own joints. Empty: every bone retracts about the world origin as
+  /// above. Else retract() rotates bone i about p = G_i p̄_i and adds ω × p, so
+  /// the tangent (ω, v) and the derivatives ∂x/∂ω = −[x]×, ∂x/∂v = I at ξ = 0 are
+  /// unchanged, but the second-order error of a finite step grows with the
+  /// distance from the bone's pivot instead of from the world origin (a
+  /// swinging hand 0.8 m from the pelvis otherwise opens its stiff joints by cm).
+  Points bone_pivots;
 
   int bone_offset(int i) const { return 6 * i; }      ///< valid only if bones_dynamic
   int z_offset() const { return bones_dynamic ? 6 * num_bones : 0; }
@@ -36,7 +44,7 @@ struct DofLayout {
 };
 
 /// Applies a tangent step `delta` (layout.size()) to `q`: bones by the
-/// exponential map (left, world frame), z additively.
+/// exponential map (left, world frame; about layout.bone_pivots when given), z additively.
 Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout);
 
 }  // namespace sflsh

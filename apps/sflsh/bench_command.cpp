@@ -1,0 +1,76 @@
+// `sflsh bench`: run time against error versus the full-FEM reference.
+#include <tbb/global_control.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "command.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/scene/benchmark.hpp"
+
+namespace sflsh::cli {
+namespace {
+
+struct BenchArgs {
+  bool quick = false, no_cache = false;
+  std::string motion = "builtin:jump", out = "bench", model = "procedural", betas, handles, cache_dir;
+  double seconds = 0;
+};
+
+void run_bench(const BenchArgs& a) {
+  // Figures are for one core: no TBB or BLAS threads.
+  setenv("OPENBLAS_NUM_THREADS", "1", 1);
+  setenv("OMP_NUM_THREADS", "1", 1);
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+
+  BenchOptions o;
+  o.quick = a.quick;
+  o.motion = a.motion;
+  o.seconds = a.seconds;
+  o.model = a.model;
+  if (!a.betas.empty()) o.betas = parse_betas(a.betas);
+  if (!a.handles.empty()) {
+    const VecX k = parse_betas(a.handles);  // same comma-separated number syntax
+    for (Eigen::Index i = 0; i < k.size(); ++i) {
+      require(k[i] >= 1 && k[i] == std::floor(k[i]), "--handles: '", k[i], "' is not a positive whole number");
+      o.handle_counts.push_back(int(k[i]));
+    }
+  }
+  if (!a.no_cache) o.precompute.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
+  std::error_code ec;
+  std::filesystem::create_directories(a.out, ec);
+  if (ec) fail(a.out, ": cannot create output folder: ", ec.message());
+
+  const auto rows = run_benchmark(o);
+  const std::string csv = (std::filesystem::path(a.out) / "bench.csv").string();
+  const std::string svg = (std::filesystem::path(a.out) / "bench.svg").string();
+  write_bench_csv(rows, csv);
+  write_bench_plot_svg(rows, svg, "sflsh bench: " + a.motion + (a.quick ? " (quick)" : ""));
+  std::printf("%-10s %4s %8s %6s %4s %9s %9s %8s %9s %9s %8s %6s\n", "method", "K", "dt", "iters", "def", "ms_med",
+              "ms_p95", "speedup", "err_mm", "max_mm", "rel_err", "peak");
+  for (const auto& r : rows)
+    std::printf("%-10s %4d %8.5f %6d %4d %9.3f %9.3f %8.1f %9.3f %9.3f %8.3f %6.3f\n", r.method.c_str(), r.handles, r.dt,
+                r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm,
+                r.rel_err, r.peak_ratio);
+  std::printf("wrote %s and %s\n", csv.c_str(), svg.c_str());
+}
+
+const CommandRegistrar reg(50, [](CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  auto* cmd = app.add_subcommand("bench", "Run time against error: reduced solver vs. full-FEM reference vs. skinning");
+  cmd->add_flag("--quick", a->quick, "Fewer variants and 0.5 s of motion");
+  cmd->add_option("--motion", a->motion, "Motion (builtin:jump|shake|idle or a file)")->capture_default_str();
+  cmd->add_option("--seconds", a->seconds, "Simulated seconds per variant (default 0.5 quick, 2 full)");
+  cmd->add_option("--model", a->model, "Body model")->capture_default_str();
+  cmd->add_option("--betas", a->betas, "Body shape b0,b1,...");
+  cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
+  cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
+  cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
+  cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.svg)")->capture_default_str();
+  cmd->callback([a] { run_bench(*a); });
+});
+
+}  // namespace
+}  // namespace sflsh::cli

@@ -1,0 +1,128 @@
+// `sflsh simulate`: drive an avatar with a motion, write the result cache,
+// optional exports and a picture.
+#include <filesystem>
+#include <iostream>
+
+#include "command.hpp"
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/material_file.hpp"
+#include "sflsh/scene/result_export.hpp"
+#include "sflsh/scene/simulation_run.hpp"
+
+namespace sflsh::cli {
+namespace {
+
+struct SimulateArgs {
+  std::string avatar, motion = "builtin:jump", out = "result.h5", exp, render, material, dt = "1/60", bones = "dynamic";
+  std::string units = "auto", joint_map;
+  double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
+  int newton_iters = 1, render_frames = 6;
+  bool line_search = false;
+};
+
+/// "1/60", "0.0166" → seconds.
+double parse_time_step(const std::string& s) {
+  double v = 0;
+  const auto slash = s.find('/');
+  try {
+    size_t used = 0;
+    if (slash == std::string::npos) {
+      v = std::stod(s, &used);
+      if (used != s.size()) throw std::invalid_argument(s);
+    } else {
+      size_t u1 = 0, u2 = 0;
+      const std::string a = s.substr(0, slash), b = s.substr(slash + 1);
+      const double num = std::stod(a, &u1), den = std::stod(b, &u2);
+      if (u1 != a.size() || u2 != b.size() || den == 0) throw std::invalid_argument(s);
+      v = num / den;
+    }
+  } catch (const std::exception&) {
+    fail("--dt: '", s, "' is not a time step (seconds, e.g. 0.0166 or 1/60)");
+  }
+  require(v > 0 && v <= 0.1, "--dt must be in (0, 0.1] s, got ", v);
+  return v;
+}
+
+void run_simulate(const SimulateArgs& a) {
+  RunOptions o;
+  o.sim.h = parse_time_step(a.dt);
+  require(a.bones == "dynamic" || a.bones == "kinematic", "--bones must be 'dynamic' or 'kinematic', got '", a.bones, "'");
+  o.sim.bones_dynamic = a.bones == "dynamic";
+  require(a.newton_iters >= 1 && a.newton_iters <= 100, "--newton-iters must be in [1, 100], got ", a.newton_iters);
+  o.sim.newton.iterations = a.newton_iters;
+  o.sim.newton.line_search = a.line_search;
+  require(a.damping >= 0, "--damping must be >= 0");
+  o.sim.damping = a.damping;
+  o.seconds = a.seconds;
+  o.output_fps = a.output_fps;
+  // Check every output can be written before spending time simulating.
+  for (const std::string& p : {a.out, a.render}) {
+    if (p.empty()) continue;
+    const auto parent = std::filesystem::path(p).parent_path();
+    require(parent.empty() || std::filesystem::is_directory(parent), p, ": output folder ", parent.string(),
+            " does not exist");
+  }
+
+  auto avatar = std::make_shared<Avatar>(read_avatar(a.avatar));
+  if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
+
+  MotionOptions mo;
+  mo.start = a.start;
+  mo.end = a.end;
+  mo.speed = a.speed;
+  mo.units = a.units;
+  mo.joint_map = a.joint_map;
+  mo.rest_joints = avatar->joints_rest;
+  mo.builtin_seconds = a.seconds > 0 ? a.seconds : 5.0;
+  MotionReport mrep;
+  const MotionClip motion = load_motion(a.motion, mo, &mrep);
+  std::cerr << mrep.describe();
+
+  // Frames stream into the result file; exports and the picture read it back.
+  o.keep_frames = false;
+  ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
+  SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+  r.avatar = a.avatar;
+  writer.finish(r);
+  std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
+  if (!a.exp.empty() || !a.render.empty()) {
+    const SimulationResult full = read_simulation_result(a.out);
+    if (!a.exp.empty()) std::cout << export_result(full, a.exp) << "\n";
+    if (!a.render.empty()) {
+      render_result(full, a.render, a.render_frames);
+      std::cout << "wrote " << a.render << "\n";
+    }
+  }
+}
+
+const CommandRegistrar reg(40, [](CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  auto* cmd = app.add_subcommand("simulate", "Simulate an avatar driven by a motion (backward Euler, reduced soft tissue)");
+  cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute`")->required();
+  cmd->add_option("--motion", a->motion, "builtin:jump|shake|idle, an AMASS .npz, a .bvh, or FBX/DAE/glTF")
+      ->capture_default_str();
+  cmd->add_option("--dt", a->dt, "Time step in seconds (e.g. 1/60)")->capture_default_str();
+  cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
+  cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
+  cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
+  cmd->add_option("--bones", a->bones, "'dynamic' (bones are DoFs tracking the motion) or 'kinematic' (prescribed)")
+      ->capture_default_str();
+  cmd->add_option("--damping", a->damping, "Stiffness-proportional damping of the soft tissue (s)")->capture_default_str();
+  cmd->add_option("--material", a->material, "YAML file overriding material parameters per region");
+  cmd->add_option("--output-fps", a->output_fps, "Frames written per simulated second")->capture_default_str();
+  cmd->add_option("--start", a->start, "Motion start time (s)");
+  cmd->add_option("--end", a->end, "Motion end time (s)");
+  cmd->add_option("--speed", a->speed, "Motion playback speed factor")->capture_default_str();
+  cmd->add_option("--units", a->units, "BVH length unit: cm|m|inch|auto")->capture_default_str();
+  cmd->add_option("--joint-map", a->joint_map, "Joint-name map file for BVH/FBX skeletons ('source smpl' per line)");
+  cmd->add_option("--out", a->out, "Result file (HDF5)")->capture_default_str();
+  cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
+  cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
+  cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
+  cmd->callback([a] { run_simulate(*a); });
+});
+
+}  // namespace
+}  // namespace sflsh::cli

@@ -1,0 +1,70 @@
+#pragma once
+// The offline pipeline (DESIGN.md §1): body model + shape β → avatar.
+//   template stage (once per body model, cached on disk): correspondence,
+//     shell tetrahedralization, volumetric weights and blend shapes;
+//   shape stage (per β): shaped nodes + thickness map, handles, bounded
+//     biharmonic weights, data-oblivious cubature.
+#include <string>
+
+#include "sflsh/asset/avatar.hpp"
+#include "sflsh/basis/bounded_biharmonic.hpp"
+#include "sflsh/basis/cubature.hpp"
+#include "sflsh/basis/handle_placement.hpp"
+#include "sflsh/body/body_model.hpp"
+#include "sflsh/volume/shape_volume.hpp"
+#include "sflsh/volume/template_volume.hpp"
+#include "sflsh/volume/thickness_map.hpp"
+
+namespace sflsh {
+
+struct PrecomputeOptions {
+  TemplateOptions template_stage;             ///< tet mesh criteria, inner surface depth
+  ShapeOptions shape_stage;
+  ThicknessMap thickness = ThicknessMap::defaults();
+  /// Number of control-point handles K (ignored when handle_positions is set).
+  int handles = 64;
+  /// User-given handle positions (#K by 3, unposed, metres), snapped to nodes.
+  Points handle_positions;
+  basis::HandlePlacementOptions placement;
+  basis::BbwOptions bbw;
+  /// Elastic cubature: samples per stratified cell (basis::stratified_cubature);
+  /// 0 = use the data-oblivious inertia samples for elasticity too.
+  int elastic_samples_per_cell = 3;
+  /// Folder of the template-stage cache ("" = no cache).
+  std::string cache_dir;
+};
+
+struct PrecomputeReport {
+  bool template_from_cache = false;
+  std::string template_cache_path;
+  TemplateReport template_report;  ///< valid when built (not loaded)
+  ShapeReport shape_report;
+  basis::BbwReport bbw_report;
+  basis::CubatureErrors elastic_errors, inertia_errors;
+  double template_s = 0, shape_geometry_s = 0, handles_s = 0, weights_s = 0, cubature_s = 0;
+  double shape_stage_s = 0;  ///< everything per β
+  double peak_rss_mib = 0;
+  std::string describe() const;
+};
+
+/// Default cache folder: $SFLSH_CACHE_DIR, else $XDG_CACHE_HOME/sflsh, else ~/.cache/sflsh.
+std::string default_cache_dir();
+
+/// The template stage, from the cache when an entry for (model hash, template
+/// options) exists, else built and stored there.
+TemplateVolume cached_template_volume(const BodyModel& model, const PrecomputeOptions& options,
+                                      PrecomputeReport* report = nullptr);
+
+/// The shape stage on a template volume.
+Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                        const PrecomputeOptions& options, PrecomputeReport* report = nullptr);
+
+/// Both stages.
+Avatar precompute_avatar(const BodyModel& model, const VecX& betas, const PrecomputeOptions& options,
+                         PrecomputeReport* report = nullptr);
+
+/// Reads handle positions: one "x y z" (or "x,y,z") per line, metres; '#'
+/// comments. Throws naming the file and line.
+Points read_handles_file(const std::string& path);
+
+}  // namespace sflsh

@@ -1,0 +1,52 @@
+#pragma once
+// `sflsh bench`: run time against error. On one avatar shape and one motion
+// (bones prescribed, soft tissue dynamic) it runs the full-FEM reference
+// (Newton to convergence, CHOLMOD), the reduced solver at several handle counts,
+// time steps and Newton iteration counts, and skinning only (u = 0), and
+// compares the soft displacement of the skin in the simulated region at common
+// frame times (30 per second).
+//
+//   rel_err    = ‖u − u_ref‖ / ‖u_ref‖  over simulated-region skin vertices and all frames
+//   err_*_mm   = mean / max over those vertices and frames of |u − u_ref| (mm)
+//   peak_ratio = max |u| / max |u_ref|
+//   speedup    = reference median step time / method median step time
+#include <string>
+#include <vector>
+
+#include "sflsh/asset/precompute.hpp"
+
+namespace sflsh {
+
+struct BenchOptions {
+  bool quick = false;                     ///< small set of variants, 0.5 s of motion
+  std::string motion = "builtin:jump";
+  double seconds = 0;                     ///< 0: 0.5 s quick, 2 s full
+  std::string model = "procedural";
+  VecX betas;
+  std::vector<int> handle_counts;         ///< empty: quick {16, 64}, full {16, 32, 64, 128}
+  int default_handles = 64;
+  double default_dt = 1.0 / 60.0;
+  int converged_newton_iters = 20;        ///< the "Newton to convergence" variant
+  PrecomputeOptions precompute;           ///< template/shape options (cache dir, ...)
+};
+
+struct BenchRow {
+  std::string method;  ///< reference | reduced | skinning
+  int handles = 0;
+  double dt = 0;
+  int newton_iters = 0;
+  bool is_default = false;
+  double ms_median = 0, ms_p95 = 0, speedup = 0;
+  double err_mean_mm = 0, err_max_mm = 0, rel_err = 0, peak_ratio = 0;
+};
+
+/// Runs every variant (progress on stderr) and returns one row each.
+std::vector<BenchRow> run_benchmark(const BenchOptions& options);
+
+/// CSV with the header
+/// method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio
+void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path);
+/// Log-log scatter of rel_err against ms per step, as SVG.
+void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& path, const std::string& title);
+
+}  // namespace sflsh

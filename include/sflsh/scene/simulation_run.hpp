@@ -1,0 +1,102 @@
+#pragma once
+// Driving an avatar with a motion: the fixed-step loop around Simulator, frame
+// output at its own rate, and the result file.
+//
+// Result file (HDF5, names fixed):
+//   /meta/format_version, /meta/units, /meta/avatar, /meta/motion, /meta/dt,
+//   /meta/bones ("dynamic" | "kinematic"), /meta/newton_iters
+//   /surface/faces        (F,3)        skin triangles
+//   /surface/rest         (V,3)        skin, unposed rest shape
+//   /frames/time          (Fr,)        s
+//   /frames/positions     (Fr,V,3)     posed surface, world, m (float32)
+//   /frames/displacement  (Fr,V,3)     soft displacement u, unposed space, m (float32)
+//   /frames/joints        (Fr,24,3)    world joint positions, m
+//   /frames/reduced       (Fr,r)       reduced DoFs z
+//   /frames/step_ms       (Fr,)        mean wall time of the steps since the previous frame
+//   /steps/{time, energy, grad_norm, newton_decrement, outcome, ms}   (S,) per step
+//     outcome: 0 accepted, 1 damped, 2 rejected
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sflsh/asset/avatar.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/motion/motion_clip.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/skeleton_terms.hpp"
+
+namespace sflsh {
+
+inline constexpr int kResultFormatVersion = 1;
+
+struct RunOptions {
+  double seconds = 0;        ///< simulated time; 0 = the motion's duration
+  double output_fps = 30;    ///< frames written per second of simulated time
+  SimulatorOptions sim;      ///< h, bones dynamic/kinematic, Newton options, ...
+  SkeletonTermsOptions skeleton;  ///< used when sim.bones_dynamic
+  bool progress = true;      ///< show a progress line
+  /// Called after every step (e.g. the benchmark records u); may be empty.
+  std::function<void(const Simulator&, const StepReport&)> on_step;
+  /// Keep every output frame in SimulationResult (memory: ~0.5 MB per frame
+  /// for a 10k-vertex body). Long runs set false and stream with on_frame.
+  bool keep_frames = true;
+};
+
+/// One output frame (what the result file stores per frame).
+struct FrameData {
+  double time = 0, step_ms = 0;
+  Points positions, displacement, joints;
+  VecX reduced;
+};
+
+struct SimulationResult {
+  std::string avatar, motion;
+  double dt = 0;
+  bool bones_dynamic = false;
+  int newton_iters = 1;
+  Triangles faces;
+  Points surface_rest;
+  std::vector<double> frame_time, frame_step_ms;
+  std::vector<Points> frame_positions, frame_displacement, frame_joints;
+  std::vector<VecX> frame_reduced;
+  std::vector<double> step_time, step_energy, step_grad_norm, step_decrement, step_ms;
+  std::vector<int> step_outcome;
+  int num_frames = 0;  ///< output frames made (kept or not)
+  int accepted = 0, damped = 0, rejected = 0;
+
+  /// Median / 95th percentile step wall time (ms).
+  double median_step_ms() const;
+  double p95_step_ms() const;
+  std::string describe() const;
+};
+
+/// Simulates `avatar` following `motion` from its first frame (state reset to
+/// the motion's first pose at rest). Every output frame is passed to
+/// `on_frame` (if given) as it is made. Throws if the state becomes non-finite.
+SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
+                                const std::function<void(const FrameData&)>& on_frame = {});
+
+/// Streams a result file: frames are appended as they come, per-step
+/// diagnostics and the meta data are written by finish(), which commits the
+/// file (nothing is left at `path` if finish() is never called).
+class ResultWriter {
+ public:
+  ResultWriter(const std::string& path, const Triangles& faces, const Points& surface_rest, int num_reduced);
+  ~ResultWriter();
+  void add_frame(const FrameData& frame);
+  void finish(const SimulationResult& result);
+  int num_frames() const { return frames_; }
+
+ private:
+  std::unique_ptr<io::Hdf5File> file_;
+  int frames_ = 0;
+};
+
+/// Bone transforms (24 world) of a motion pose on the avatar's skeleton.
+std::vector<Isometry> target_bones(const Avatar& avatar, const BodyPose& pose);
+
+void write_simulation_result(const SimulationResult& result, const std::string& path);
+SimulationResult read_simulation_result(const std::string& path);
+
+}  // namespace sflsh

@@ -1,0 +1,53 @@
+#pragma once
+// Soft-tissue elasticity in the unposed space (seed §4; DESIGN.md §4):
+//   E(z) = Σ_k c_k Ψ(F_k),   F_k = I + ∂u/∂x̄ = I + Σ_h z_h d_{k,h}ᵀ,
+// with the avatar's `elastic` cubature (c_k in m³) and the material and frame
+// of the sample's tet (sim/material.hpp). Tets are linear, so ∂u/∂x̄ is constant
+// per tet: d_{k,h} = Σ_n W_{n,h} ∇N_n (3-vector, 1/m) is precomputed for the
+// handles h touching the tet (Dirichlet nodes contribute nothing).
+// Depends on z only. Hessian: Σ_k c_k G_kᵀ ΠPSD(∂²Ψ/∂F²) G_k (per-sample 9x9
+// eigenvalue clamping), G_k = ∂vec(F_k)/∂z.
+#include <vector>
+
+#include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/material.hpp"
+
+namespace sflsh {
+
+class ElasticTerm : public EnergyTerm {
+ public:
+  /// Uses avatar.elastic, tet_frames, tet_region, materials. `project_psd` =
+  /// false keeps the exact (possibly indefinite) Hessian, for derivative checks.
+  explicit ElasticTerm(const Avatar& avatar, bool project_psd = true);
+  std::string name() const override { return "elastic"; }
+  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+
+  /// Deformation gradient of sample k for reduced DoFs z.
+  Mat3 deformation_gradient(int k, const VecX& z) const;
+  int num_samples() const { return int(weight_.size()); }
+  /// Smallest det F over the samples (> 0 means no inverted cubature element).
+  double min_det(const VecX& z) const;
+
+ private:
+  VecX weight_;                        // #S c_k (m³)
+  std::vector<Mat3> frame_;            // #S local frames (rows along/through/around)
+  std::vector<const RegionMaterial*> material_;
+  std::vector<int> start_{0}, handle_;  // CSR over samples: handles touching the tet
+  std::vector<Vec3> d_;                 // per entry: ∂u/∂x̄ per unit z_h (1/m)
+  int num_reduced_ = 0;
+  bool project_psd_ = true;
+};
+
+/// #T by 4 by 3 shape-function gradients: row t holds ∇N_0..∇N_3 (1/m) of tet t
+/// in the unposed space, as #T by 12 (∇N_c at columns 3c..3c+2). Throws on a
+/// degenerate or inverted tet (naming it).
+MatXr tet_shape_gradients(const TetMesh& mesh);
+
+/// Frame of tet t from avatar.tet_frames (row-major 3x3), or the identity when
+/// the asset has no frames.
+Mat3 tet_frame(const Avatar& avatar, int t);
+/// Material of tet t (avatar.materials[tet_region[t]], or the first one when
+/// tet_region is empty). Throws when the avatar has no materials.
+const RegionMaterial& tet_material(const Avatar& avatar, int t);
+
+}  // namespace sflsh

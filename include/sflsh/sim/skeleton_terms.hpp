@@ -1,0 +1,56 @@
+#pragma once
+// The skeleton's energy terms (seed §3) with documented defaults: bone
+// rigid-body inertia and gravity (the skeleton's own mass), joint
+// constraints, joint limits and motion-tracking springs.
+#include <vector>
+
+#include "sflsh/sim/energies/bone_inertia.hpp"
+#include "sflsh/sim/energy_term.hpp"
+
+namespace sflsh {
+
+struct SkeletonTermsOptions {
+  /// Body mass, kg. ≤ 0: estimate_body_mass(avatar) (skin volume × 1000 kg/m³).
+  double body_mass = 0.0;
+  /// Share of the body mass in the bones' rigid bodies: the skeleton's own
+  /// mass (adult skeleton ≈ 15 %); the rest is soft-tissue mass handled by the
+  /// soft inertia term (bone_inertia.hpp explains the budget).
+  double skeleton_mass_fraction = 0.15;
+
+  bool bone_inertia = true;      ///< rigid-body inertia of the bones
+  bool bone_gravity = true;      ///< gravity on the skeleton's own mass
+  bool joint_constraints = true; ///< keep the bones connected
+  bool joint_limits = true;      ///< anatomical ranges (joint_limits_table.hpp)
+  bool tracking = true;          ///< springs to ctx.target_pose
+
+  /// Joint constraint stiffness k = ratio · body_mass / h² (N/m): a force
+  /// body_mass·a opens a joint by a h²/ratio (0.03 mm for g at h = 1/60 s).
+  double joint_stiffness_ratio = 100.0;
+  /// Joint limit springs k_j = I_j (2π f)² (I_j: subtree inertia about joint j),
+  /// f in Hz; stiffer than tracking so limits win over implausible targets.
+  double limit_frequency_hz = 30.0;
+  /// Tracking springs: k_j = I_j (2π f)², root position k = body_mass (2π f)²
+  /// (f in Hz). A constant target acceleration a is followed with a lag of
+  /// a/(2π f)² (0.6 mm at g for 20 Hz). Measured with one Newton step per
+  /// 1/60 s step (tests/sim/skeleton_terms_test.cpp), 20 Hz, steps solved in
+  /// the pelvis-centred frame with bones turning about their joints
+  /// (simulator.hpp, configuration.hpp): 1.5 mm / 0.004 rad max joint error on
+  /// a 1 Hz walk, 5.6 mm / 0.016 rad at 2 Hz.
+  double tracking_frequency_hz = 20.0;
+};
+
+/// Body mass (kg) from the closed skin surface of the avatar (volume by the
+/// divergence theorem × 1000 kg/m³). Throws if the surface is missing or not
+/// closed and outward oriented (volume ≤ 0).
+double estimate_body_mass(const Avatar& avatar);
+
+/// Rotational inertia (kg m²) about each joint of everything it moves (the
+/// joint's subtree of `bodies`, parallel-axis theorem about J̄_j): the largest
+/// principal moment, #J. Joint 0: the whole body about the root joint.
+std::vector<double> joint_subtree_inertia(const Avatar& avatar, const std::vector<BoneBody>& bodies);
+
+/// Appends the enabled skeletal terms to `terms`, in the order inertia,
+/// gravity, joint constraints, joint limits, tracking.
+void add_skeleton_terms(std::vector<EnergyTermPtr>& terms, const Avatar& avatar, const SkeletonTermsOptions& options);
+
+}  // namespace sflsh

@@ -1,0 +1,84 @@
+#pragma once
+// The geometric part of the shape stage of `sflsh precompute` (seed §4): the
+// template tet mesh moved to shape β, the spatially varying skin thickness,
+// and the avatar's geometric fields (surface embedding, regions, materials,
+// local frames, capsules).
+#include "sflsh/asset/avatar.hpp"
+#include "sflsh/body/body_model.hpp"
+#include "sflsh/mesh/tet_quality.hpp"
+#include "sflsh/volume/template_volume.hpp"
+#include "sflsh/volume/thickness_map.hpp"
+
+namespace sflsh {
+
+struct ShapeOptions {
+  /// Smallest depth fraction a node may reach when the soft layer is
+  /// thickened (keeps the bone surface off the skeleton).
+  double min_depth = 0.1;
+  /// Jacobi smoothing iterations of the per-node thickness scale over the
+  /// tet graph, so region borders blend instead of stepping.
+  int scale_smoothing_iterations = 10;
+  /// Capsule radius = this percentile of the skin-node thicknesses of a bone.
+  double capsule_percentile = 0.5;
+  /// Rounds of relaxing the thickness scale towards 1 around inverted tets
+  /// (halved each round, set to 1 in the last) before giving up.
+  int max_relax_rounds = 6;
+  /// The thickness map may not push a tet's smallest dihedral angle below
+  /// this (deg) or below its value at thickness scale 1, whichever is lower
+  /// (a floor, not a target: changing the layer thickness alters every
+  /// tet's angles a little).
+  double min_dihedral_deg = 2.0;
+};
+
+struct ShapeReport {
+  TetQualityReport quality;
+  double max_embedding_distance = 0;  ///< m, skin vertices outside the tet mesh
+  int num_embedded_outside = 0;
+  /// Nodes whose thickness scale was relaxed towards 1 to avoid inverted tets.
+  int num_relaxed_nodes = 0;
+  double seconds = 0;
+  std::string describe() const;
+};
+
+struct ShapedVolume {
+  /// Fields filled: betas, model_hash, model_source, joints_rest, parents,
+  /// joint_names, capsules, surface_* (rest, faces, weights, posedirs, tet,
+  /// bary), tet, node_weights, node_role, surface_nodes, tet_region,
+  /// tet_frames, materials. Basis and cubature are left empty.
+  Avatar avatar;
+  VecX node_depth;       ///< #N depth fraction after the thickness map
+  VecX node_thickness_scale;  ///< #N smoothed thickness scale applied
+  ShapeReport report;
+};
+
+/// Shape stage (geometry) for shape `betas` (missing entries 0). Nodes
+/// follow the correspondence path: x = s(β) + d' (σ(β) - s(β)) + ρ(β), with
+/// s the skeleton point (from the shaped joints), σ the skin point,
+/// d' = 1 - k (1 - d) the depth with the soft layer scaled by k (thickness
+/// map, limited so d' >= min_depth) and ρ the template residual carried in
+/// the frame of the path (rotated with σ - s and scaled by its length). A
+/// uniformly scaled body therefore gives the uniformly scaled mesh, and with
+/// k = 1 the nodes are template nodes + Σ β_b node_shapedirs[b] up to the
+/// residual's change. Where the thickened layer would invert tets, k is
+/// relaxed towards 1 locally (ShapeReport::num_relaxed_nodes); likewise
+/// where it would flatten tets (ShapeOptions::min_dihedral_deg). Throws if
+/// tets stay inverted (then the shape itself folds the mesh) or `tv` was
+/// built from another model.
+ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                          const ThicknessMap& thickness = ThicknessMap::defaults(), const ShapeOptions& options = {});
+
+/// Local material frames per tet, #T by 9 row-major 3x3 with rows: along the
+/// bone (segment direction), through the thickness (skeleton -> tissue,
+/// orthogonalised), around (along × through). `node_skeleton` #N by 3.
+MatXr tet_frames(const TetMesh& tet, const Points& node_skeleton, const VecXi& node_segment,
+                 const std::vector<BoneSegment>& segments, const std::vector<int>& parents, const Points& joints);
+
+/// One capsule per bone segment fitted to its flesh: the segment, radius =
+/// `percentile` of the distances skin node -> skeleton point over the skin
+/// nodes on that segment. Segments with fewer than 8 such nodes or shorter
+/// than 1 cm get none.
+std::vector<BoneCapsule> fit_bone_capsules(const Points& nodes, const Points& node_skeleton, const VecXi& skin_nodes,
+                                           const VecXi& node_segment, const std::vector<BoneSegment>& segments,
+                                           const std::vector<int>& parents, const Points& joints, double percentile);
+
+}  // namespace sflsh

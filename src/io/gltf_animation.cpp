@@ -1,0 +1,180 @@
+#include "sflsh/io/gltf_animation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/surface_normals.hpp"
+
+namespace sflsh::io {
+
+namespace {
+
+// glTF 2.0 enumerations (spec §3.6.2.2 and §3.6.1).
+constexpr int kFloat = 5126, kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+
+/// Binary buffer plus the JSON of its bufferViews and accessors, built together
+/// so that offsets and indices can not disagree.
+class GltfBuffers {
+ public:
+  /// Appends float32 data as a new bufferView + accessor; returns the accessor index.
+  /// `type` is "SCALAR" or "VEC3"; `with_bounds` adds min/max (required for POSITION).
+  int add_floats(const std::vector<float>& values, const char* type, int target, bool with_bounds) {
+    const int comps = std::strcmp(type, "VEC3") == 0 ? 3 : 1;
+    std::string bounds;
+    if (with_bounds) {
+      float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      for (size_t i = 0; i < values.size(); ++i) {
+        lo[i % size_t(comps)] = std::min(lo[i % size_t(comps)], values[i]);
+        hi[i % size_t(comps)] = std::max(hi[i % size_t(comps)], values[i]);
+      }
+      bounds = ",\"min\":[" + list(lo, comps) + "],\"max\":[" + list(hi, comps) + "]";
+    }
+    return add(values.data(), values.size() * 4, kFloat, values.size() / size_t(comps), type, target, bounds);
+  }
+  int add_indices(const std::vector<std::uint32_t>& values) {
+    return add(values.data(), values.size() * 4, kUnsignedInt, values.size(), "SCALAR", kElementArrayBuffer, "");
+  }
+  const std::string& bin() const { return bin_; }
+  std::string views_json() const { return "[" + views_ + "]"; }
+  std::string accessors_json() const { return "[" + accessors_ + "]"; }
+
+ private:
+  static std::string list(const float* v, int n) {
+    std::string s;
+    for (int i = 0; i < n; ++i) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%s%.9g", i ? "," : "", double(v[i]));
+      s += buf;
+    }
+    return s;
+  }
+  int add(const void* data, size_t bytes, int component, size_t count, const char* type, int target,
+          const std::string& bounds) {
+    // Every element here is 4 bytes, so 4-byte alignment of each view suffices.
+    const size_t offset = bin_.size();
+    // Little-endian host assumed for the raw copy (x86-64 / arm64 Linux).
+    bin_.append(static_cast<const char*>(data), bytes);
+    std::ostringstream v, a;
+    v << (views_.empty() ? "" : ",") << "{\"buffer\":0,\"byteOffset\":" << offset << ",\"byteLength\":" << bytes;
+    if (target) v << ",\"target\":" << target;
+    v << "}";
+    a << (accessors_.empty() ? "" : ",") << "{\"bufferView\":" << num_ << ",\"componentType\":" << component
+      << ",\"count\":" << count << ",\"type\":\"" << type << "\"" << bounds << "}";
+    views_ += v.str();
+    accessors_ += a.str();
+    return num_++;
+  }
+  std::string bin_, views_, accessors_;
+  int num_ = 0;
+};
+
+std::vector<float> to_floats(const Points& P) {
+  std::vector<float> out(size_t(P.size()));
+  for (Eigen::Index i = 0; i < P.rows(); ++i)
+    for (int c = 0; c < 3; ++c) out[size_t(i) * 3 + size_t(c)] = float(P(i, c));
+  return out;
+}
+
+void put_u32(std::string& s, std::uint32_t x) {
+  for (int i = 0; i < 4; ++i) s.push_back(char((x >> (8 * i)) & 0xff));
+}
+
+}  // namespace
+
+void write_animated_glb(const std::string& path, const std::vector<Points>& frames, const Triangles& F, double fps,
+                        const Points& colors) {
+  require(lower_extension(path) == ".glb", path, ": an animated glTF is written as .glb");
+  require(!frames.empty(), path, ": no frames to write");
+  require(std::isfinite(fps) && fps > 0, path, ": fps must be positive, got ", fps);
+  const Eigen::Index nv = frames.front().rows();
+  for (size_t k = 0; k < frames.size(); ++k) {
+    require(frames[k].rows() == nv, path, ": frame ", k, " has ", frames[k].rows(), " vertices, expected ", nv);
+    require(frames[k].allFinite(), path, ": frame ", k, " contains NaN or Inf");
+  }
+  require(F.rows() > 0 && F.minCoeff() >= 0 && F.maxCoeff() < nv, path, ": face indices must lie in [0, ", nv, ")");
+  require(colors.rows() == 0 || colors.rows() == nv, path, ": colors has ", colors.rows(), " rows, expected ", nv);
+
+  GltfBuffers buf;
+  std::vector<std::uint32_t> idx(size_t(F.size()));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) idx[size_t(f) * 3 + size_t(c)] = std::uint32_t(F(f, c));
+  const int indices = buf.add_indices(idx);
+  const Points n0 = vertex_normals(frames.front(), F);
+  const int position = buf.add_floats(to_floats(frames.front()), "VEC3", kArrayBuffer, true);
+  const int normal = buf.add_floats(to_floats(n0), "VEC3", kArrayBuffer, false);
+  int color = -1;
+  if (colors.rows()) color = buf.add_floats(to_floats(colors.cwiseMax(0.0).cwiseMin(1.0)), "VEC3", kArrayBuffer, false);
+
+  const size_t num_targets = frames.size() - 1;
+  std::ostringstream targets;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const int dp = buf.add_floats(to_floats(frames[k] - frames.front()), "VEC3", kArrayBuffer, true);
+    const int dn = buf.add_floats(to_floats(vertex_normals(frames[k], F) - n0), "VEC3", kArrayBuffer, false);
+    targets << (k > 1 ? "," : "") << "{\"POSITION\":" << dp << ",\"NORMAL\":" << dn << "}";
+  }
+
+  std::ostringstream js;
+  js << "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sflsh\",\"extras\":{\"units\":\"metres\",\"fps\":" << fps
+     << "}},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"body\"}],";
+  js << "\"materials\":[{\"name\":\"skin\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
+     << (colors.rows() ? "[1,1,1,1]" : "[0.87,0.7,0.6,1]") << ",\"metallicFactor\":0,\"roughnessFactor\":0.7}}],";
+  js << "\"meshes\":[{\"name\":\"body\",\"primitives\":[{\"attributes\":{\"POSITION\":" << position
+     << ",\"NORMAL\":" << normal;
+  if (color >= 0) js << ",\"COLOR_0\":" << color;
+  js << "},\"indices\":" << indices << ",\"material\":0,\"mode\":4";
+  if (num_targets) {
+    js << ",\"targets\":[" << targets.str() << "]}],\"weights\":[";
+    for (size_t t = 0; t < num_targets; ++t) js << (t ? ",0" : "0");
+    js << "]}]";
+    // Keyframe k: time k/fps, weights one-hot on target k-1 (all zero at k = 0).
+    std::vector<float> times(frames.size()), weights(frames.size() * num_targets, 0.f);
+    for (size_t k = 0; k < frames.size(); ++k) {
+      times[k] = float(double(k) / fps);
+      if (k > 0) weights[k * num_targets + (k - 1)] = 1.f;
+    }
+    const int input = buf.add_floats(times, "SCALAR", 0, true);  // sampler input needs min/max
+    const int output = buf.add_floats(weights, "SCALAR", 0, false);
+    js << ",\"animations\":[{\"name\":\"simulation\",\"samplers\":[{\"input\":" << input << ",\"output\":" << output
+       << ",\"interpolation\":\"LINEAR\"}],\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}]}]";
+  } else {
+    js << "}]}]";
+  }
+  js << ",\"buffers\":[{\"byteLength\":" << buf.bin().size() << "}],\"bufferViews\":" << buf.views_json()
+     << ",\"accessors\":" << buf.accessors_json() << "}";
+
+  // GLB container (spec §4.4): 12-byte header, JSON chunk padded with spaces,
+  // BIN chunk padded with zeros, both to 4 bytes.
+  std::string json = js.str();
+  json.append((4 - json.size() % 4) % 4, ' ');
+  std::string bin = buf.bin();
+  bin.append((4 - bin.size() % 4) % 4, '\0');
+  std::string glb;
+  put_u32(glb, 0x46546C67u);  // "glTF"
+  put_u32(glb, 2);
+  put_u32(glb, std::uint32_t(12 + 8 + json.size() + 8 + bin.size()));
+  put_u32(glb, std::uint32_t(json.size()));
+  put_u32(glb, 0x4E4F534Au);  // "JSON"
+  AtomicOutput out(path);
+  std::ofstream os(out.temp_path(), std::ios::binary);
+  require(bool(os), path, ": cannot open ", out.temp_path(), " for writing");
+  os.write(glb.data(), std::streamsize(glb.size()));
+  os.write(json.data(), std::streamsize(json.size()));
+  std::string bin_header;
+  put_u32(bin_header, std::uint32_t(bin.size()));
+  put_u32(bin_header, 0x004E4942u);  // "BIN\0"
+  os.write(bin_header.data(), 8);
+  os.write(bin.data(), std::streamsize(bin.size()));
+  os.close();
+  require(bool(os), path, ": write failed (disk full?)");
+  out.commit();
+}
+
+}  // namespace sflsh::io

@@ -1,0 +1,297 @@
+#include "sflsh/scene/benchmark.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/progress.hpp"
+#include "sflsh/core/timer.hpp"
+#include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/simulation_run.hpp"
+#include "sflsh/sim/full_fem.hpp"
+
+namespace sflsh {
+namespace {
+
+constexpr double kFrameRate = 30.0;  // comparison frames per simulated second
+
+/// Soft displacement of the skin at the comparison frames plus step timings.
+struct Trace {
+  std::vector<Points> u;   // per frame, #V by 3 (m)
+  std::vector<double> ms;  // per step
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, size_t(std::lround(p * double(v.size() - 1))))];
+}
+
+/// Steps per comparison frame for time step h (h must divide 1/30 s).
+int steps_per_frame(double h) {
+  const double r = 1.0 / (kFrameRate * h);
+  const int n = int(std::lround(r));
+  require(n >= 1 && std::abs(r - n) < 1e-6, "bench: time step ", h, " s does not divide 1/", kFrameRate, " s");
+  return n;
+}
+
+Trace run_reference(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h) {
+  FullFemOptions o;
+  o.h = h;
+  // Errors are reported to a few significant digits: a relative gradient
+  // reduction of 1e-6 per step leaves the reference far more accurate than
+  // that while keeping the converged solve affordable.
+  o.gradient_tolerance = 1e-6;
+  FullFem fem(avatar, o);
+  fem.reset(target_bones(*avatar, motion.sample(0)));
+  Trace tr;
+  tr.u.push_back(fem.soft_displacement());
+  const int per = steps_per_frame(h);
+  const long steps = std::lround(seconds / h);
+  Progress p("bench: full-FEM reference", steps);
+  for (long s = 1; s <= steps; ++s) {
+    const FullFemReport rep = fem.step(target_bones(*avatar, motion.sample(s * h)));
+    tr.ms.push_back(rep.ms_total);
+    if (s % per == 0) tr.u.push_back(fem.soft_displacement());
+    p.update(s);
+  }
+  p.finish();
+  return tr;
+}
+
+Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
+                  int newton_iters, const std::string& label) {
+  SimulatorOptions o;
+  o.h = h;
+  o.bones_dynamic = false;
+  o.newton.iterations = newton_iters;
+  o.newton.line_search = newton_iters > 1;
+  Simulator sim(avatar, o);
+  sim.reset(target_bones(*avatar, motion.sample(0)));
+  Trace tr;
+  tr.u.push_back(sim.soft_displacement());
+  const int per = steps_per_frame(h);
+  const long steps = std::lround(seconds / h);
+  Progress p("bench: " + label, steps);
+  for (long s = 1; s <= steps; ++s) {
+    const BodyPose pose = motion.sample(s * h);
+    const StepReport rep = sim.step(target_bones(*avatar, pose), pose);
+    require(sim.state().z.allFinite(), "bench: ", label, " became non-finite at step ", s);
+    tr.ms.push_back(rep.ms_total);
+    if (s % per == 0) tr.u.push_back(sim.soft_displacement());
+    p.update(s);
+  }
+  p.finish();
+  return tr;
+}
+
+/// Linear blend skinning of the surface with u = 0: the cost of "doing nothing".
+Trace run_skinning(const Avatar& a, const MotionClip& motion, double seconds, double h) {
+  Trace tr;
+  const long steps = std::lround(seconds / h);
+  const int per = steps_per_frame(h);
+  const Points zero = Points::Zero(a.surface_rest.rows(), 3);
+  tr.u.push_back(zero);
+  Points x(a.surface_rest.rows(), 3);
+  for (long s = 1; s <= steps; ++s) {
+    Timer t;
+    const auto G = target_bones(a, motion.sample(s * h));
+    for (Eigen::Index v = 0; v < a.surface_rest.rows(); ++v) {
+      Vec3 p = Vec3::Zero();
+      const Vec3 xr = a.surface_rest.row(v);
+      for (int j = 0; j < 24; ++j)
+        if (const double w = a.surface_weights(v, j); w != 0.0) p += w * (G[j] * xr);
+      x.row(v) = p;
+    }
+    tr.ms.push_back(t.ms());
+    if (s % per == 0) tr.u.push_back(zero);
+  }
+  return tr;
+}
+
+/// Skin vertices whose embedding tet has a Simulated node.
+std::vector<int> simulated_region(const Avatar& a) {
+  std::vector<int> out;
+  for (Eigen::Index v = 0; v < a.surface_rest.rows(); ++v) {
+    const int t = a.surface_tet[v];
+    for (int c = 0; c < 4; ++c)
+      if (a.node_role[a.tet.elements(t, c)] == int(NodeRole::Simulated)) {
+        out.push_back(int(v));
+        break;
+      }
+  }
+  return out;
+}
+
+void compare(const Trace& tr, const Trace& ref, const std::vector<int>& region, BenchRow& row) {
+  const size_t F = std::min(tr.u.size(), ref.u.size());
+  double diff2 = 0, ref2 = 0, sum = 0, mx = 0, peak = 0, peak_ref = 0;
+  long count = 0;
+  for (size_t f = 0; f < F; ++f)
+    for (int v : region) {
+      const Vec3 d = tr.u[f].row(v) - ref.u[f].row(v);
+      const double e = d.norm();
+      diff2 += d.squaredNorm();
+      ref2 += ref.u[f].row(v).squaredNorm();
+      sum += e;
+      mx = std::max(mx, e);
+      peak = std::max(peak, tr.u[f].row(v).norm());
+      peak_ref = std::max(peak_ref, ref.u[f].row(v).norm());
+      ++count;
+    }
+  row.err_mean_mm = count ? 1e3 * sum / double(count) : 0;
+  row.err_max_mm = 1e3 * mx;
+  row.rel_err = ref2 > 0 ? std::sqrt(diff2 / ref2) : 0;
+  row.peak_ratio = peak_ref > 0 ? peak / peak_ref : 0;
+  row.ms_median = percentile(tr.ms, 0.5);
+  row.ms_p95 = percentile(tr.ms, 0.95);
+}
+
+}  // namespace
+
+std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
+  BenchOptions o = in;
+  if (o.seconds <= 0) o.seconds = o.quick ? 0.5 : 2.0;
+  if (o.handle_counts.empty()) o.handle_counts = o.quick ? std::vector<int>{16, 64} : std::vector<int>{16, 32, 64, 128};
+  if (std::find(o.handle_counts.begin(), o.handle_counts.end(), o.default_handles) == o.handle_counts.end())
+    o.handle_counts.push_back(o.default_handles);
+
+  const BodyModel model = load_body_model(o.model);
+  const TemplateVolume tv = cached_template_volume(model, o.precompute);
+  std::vector<std::shared_ptr<const Avatar>> avatars;
+  for (int K : o.handle_counts) {
+    PrecomputeOptions po = o.precompute;
+    po.handles = K;
+    log_info("bench: shape stage with K = " + std::to_string(K) + " handles");
+    avatars.push_back(std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po)));
+  }
+  const Avatar& base = *avatars.front();
+  MotionOptions mo;
+  mo.rest_joints = base.joints_rest;
+  mo.builtin_seconds = o.seconds + 0.5;
+  const MotionClip motion = load_motion(o.motion, mo);
+  const std::vector<int> region = simulated_region(base);
+
+  const double h = o.default_dt;
+  const Trace ref = run_reference(avatars.front(), motion, o.seconds, h);
+  std::vector<BenchRow> rows;
+  BenchRow rr{"reference", 0, h, -1, false};
+  compare(ref, ref, region, rr);
+  rows.push_back(rr);
+  const double ref_ms = rr.ms_median;
+
+  auto add = [&](const Trace& tr, const std::string& method, int K, double dt, int iters, bool is_default) {
+    BenchRow r{method, K, dt, iters, is_default};
+    compare(tr, ref, region, r);
+    r.speedup = r.ms_median > 0 ? ref_ms / r.ms_median : 0;
+    rows.push_back(r);
+  };
+  for (size_t i = 0; i < avatars.size(); ++i) {
+    const int K = o.handle_counts[i];
+    const bool is_def_K = K == o.default_handles;
+    add(run_reduced(avatars[i], motion, o.seconds, h, 1, "reduced K=" + std::to_string(K)), "reduced", K, h, 1,
+        is_def_K);
+    if (!is_def_K) continue;
+    // Time steps and Newton iterations around the default.
+    std::vector<double> dts = o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0};
+    for (double dt : dts)
+      add(run_reduced(avatars[i], motion, o.seconds, dt, 1, "reduced K=" + std::to_string(K) + " dt=" + std::to_string(dt)),
+          "reduced", K, dt, 1, false);
+    add(run_reduced(avatars[i], motion, o.seconds, h, o.converged_newton_iters,
+                    "reduced K=" + std::to_string(K) + " converged"),
+        "reduced", K, h, o.converged_newton_iters, false);
+  }
+  add(run_skinning(base, motion, o.seconds, h), "skinning", 0, h, 0, false);
+  return rows;
+}
+
+void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path) {
+  const std::string tmp = path + ".partial";
+  {
+    std::ofstream f(tmp);
+    if (!f) fail(path, ": cannot write");
+    f << "method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio\n";
+    char buf[512];
+    for (const auto& r : rows) {
+      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g\n", r.method.c_str(), r.handles,
+                    r.dt, r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup, r.err_mean_mm,
+                    r.err_max_mm, r.rel_err, r.peak_ratio);
+      f << buf;
+    }
+    if (!f) fail(path, ": write failed");
+  }
+  std::rename(tmp.c_str(), path.c_str());
+}
+
+void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& path, const std::string& title) {
+  // Log-log axes: x = ms per step, y = relative error (the reference sits at 0
+  // error, so it is drawn as a vertical line at its step time).
+  const double W = 720, H = 480, L = 80, R = 200, T = 50, B = 60;
+  double xmin = 1e9, xmax = 0, ymin = 1e9, ymax = 0;
+  for (const auto& r : rows) {
+    xmin = std::min(xmin, std::max(r.ms_median, 1e-3));
+    xmax = std::max(xmax, r.ms_median);
+    if (r.method != "reference") {
+      ymin = std::min(ymin, std::max(r.rel_err, 1e-4));
+      ymax = std::max(ymax, r.rel_err);
+    }
+  }
+  const double lx0 = std::floor(std::log10(xmin)), lx1 = std::ceil(std::log10(xmax) + 1e-9);
+  const double ly0 = std::floor(std::log10(ymin)), ly1 = std::max(std::ceil(std::log10(ymax) + 1e-9), ly0 + 1);
+  auto X = [&](double v) { return L + (std::log10(std::max(v, 1e-3)) - lx0) / (lx1 - lx0) * (W - L - R); };
+  auto Y = [&](double v) { return H - B - (std::log10(std::max(v, 1e-4)) - ly0) / (ly1 - ly0) * (H - T - B); };
+  std::ofstream f(path + ".partial");
+  if (!f) fail(path, ": cannot write");
+  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
+    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  f << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
+  for (double e = lx0; e <= lx1; ++e)
+    f << "<line x1='" << X(std::pow(10, e)) << "' y1='" << T << "' x2='" << X(std::pow(10, e)) << "' y2='" << H - B
+      << "' stroke='#ddd'/><text x='" << X(std::pow(10, e)) << "' y='" << H - B + 18 << "' text-anchor='middle'>"
+      << std::pow(10, e) << "</text>\n";
+  for (double e = ly0; e <= ly1; ++e)
+    f << "<line x1='" << L << "' y1='" << Y(std::pow(10, e)) << "' x2='" << W - R << "' y2='" << Y(std::pow(10, e))
+      << "' stroke='#ddd'/><text x='" << L - 6 << "' y='" << Y(std::pow(10, e)) + 4 << "' text-anchor='end'>"
+      << std::pow(10, e) << "</text>\n";
+  f << "<rect x='" << L << "' y='" << T << "' width='" << W - L - R << "' height='" << H - T - B
+    << "' fill='none' stroke='black'/>\n";
+  f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 18 << "' text-anchor='middle'>ms per step (median, log)</text>\n";
+  f << "<text transform='translate(20," << (T + H - B) / 2
+    << ") rotate(-90)' text-anchor='middle'>relative soft-displacement error (log)</text>\n";
+  int legend = 0;
+  for (const auto& r : rows) {
+    std::string label, color;
+    char buf[128];
+    if (r.method == "reference") {
+      std::snprintf(buf, sizeof buf, "full-FEM reference %.0f ms", r.ms_median);
+      label = buf;
+      color = "#444";
+      f << "<line x1='" << X(r.ms_median) << "' y1='" << T << "' x2='" << X(r.ms_median) << "' y2='" << H - B
+        << "' stroke='" << color << "' stroke-dasharray='6,4'/>\n";
+    } else {
+      if (r.method == "skinning") {
+        label = "skinning only";
+        color = "#d62728";
+      } else {
+        std::snprintf(buf, sizeof buf, "K=%d dt=1/%.0f %s%s", r.handles, 1.0 / r.dt,
+                      r.newton_iters > 1 ? "converged" : "1 Newton", r.is_default ? " (default)" : "");
+        label = buf;
+        color = r.newton_iters > 1 ? "#2ca02c" : r.dt != rows[0].dt ? "#ff7f0e" : "#1f77b4";
+      }
+      f << "<circle cx='" << X(r.ms_median) << "' cy='" << Y(r.rel_err) << "' r='" << (r.is_default ? 7 : 5)
+        << "' fill='" << color << "' stroke='black'/>\n";
+    }
+    const double ly = T + 14 + 18 * legend++;
+    f << "<circle cx='" << W - R + 14 << "' cy='" << ly - 4 << "' r='5' fill='" << color << "'/><text x='" << W - R + 24
+      << "' y='" << ly << "'>" << label << "</text>\n";
+  }
+  f << "</svg>\n";
+  f.close();
+  std::rename((path + ".partial").c_str(), path.c_str());
+}
+
+}  // namespace sflsh

@@ -1,0 +1,83 @@
+#include "sflsh/scene/material_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "sflsh/core/error.hpp"
+
+namespace sflsh {
+namespace {
+
+std::string where(const std::string& path, const YAML::Node& n) {
+  return path + ":" + std::to_string(n.Mark().line + 1);
+}
+
+void apply(const std::string& path, const YAML::Node& params, RegionMaterial& m) {
+  if (!params.IsMap()) fail(where(path, params), ": expected a map of material parameters for region '", m.name, "'");
+  for (const auto& kv : params) {
+    const std::string key = kv.first.as<std::string>();
+    double v;
+    try {
+      v = kv.second.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(where(path, kv.second), ": '", key, "' must be a number");
+    }
+    if (!std::isfinite(v)) fail(where(path, kv.second), ": '", key, "' must be finite");
+    auto positive = [&](double& slot) {
+      if (v <= 0) fail(where(path, kv.second), ": '", key, "' must be positive, got ", v);
+      slot = v;
+    };
+    if (key == "young") {
+      positive(m.young_along);
+      m.young_through = m.young_around = v;
+    } else if (key == "young_along") positive(m.young_along);
+    else if (key == "young_through") positive(m.young_through);
+    else if (key == "young_around") positive(m.young_around);
+    else if (key == "fung_c") positive(m.fung_c);
+    else if (key == "density") positive(m.density);
+    else if (key == "poisson") {
+      if (v <= -1.0 || v >= 0.5) fail(where(path, kv.second), ": 'poisson' must be in (-1, 0.5), got ", v);
+      m.poisson = v;
+    } else {
+      fail(where(path, kv.first), ": unknown material key '", key,
+           "' (expected young, young_along, young_through, young_around, poisson, fung_c, density)");
+    }
+  }
+}
+
+}  // namespace
+
+void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials) {
+  if (!std::filesystem::exists(path)) fail(path, ": material file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    fail(path, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
+  }
+  if (!root.IsMap()) fail(path, ": expected a map with 'all' and/or 'regions'");
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (key == "all") {
+      for (auto& m : materials) apply(path, kv.second, m);
+    } else if (key == "regions") {
+      if (!kv.second.IsMap()) fail(where(path, kv.second), ": 'regions' must map region names to parameters");
+      for (const auto& r : kv.second) {
+        const std::string name = r.first.as<std::string>();
+        auto it = std::find_if(materials.begin(), materials.end(), [&](const RegionMaterial& m) { return m.name == name; });
+        if (it == materials.end()) {
+          std::string known;
+          for (const auto& m : materials) known += (known.empty() ? "" : ", ") + m.name;
+          fail(where(path, r.first), ": unknown region '", name, "' (this avatar has: ", known, ")");
+        }
+        apply(path, r.second, *it);
+      }
+    } else {
+      fail(where(path, kv.first), ": unknown top-level key '", key, "' (expected 'all' or 'regions')");
+    }
+  }
+}
+
+}  // namespace sflsh

@@ -1,0 +1,50 @@
+#include "sflsh/sim/energies/tracking.hpp"
+
+#include <cmath>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
+
+namespace sflsh {
+
+Tracking::Tracking(const Avatar& avatar, std::vector<double> rotation_stiffness, double position_stiffness)
+    : joints_rest_(avatar.joints_rest),
+      parents_(avatar.parents),
+      k_rot_(std::move(rotation_stiffness)),
+      k_pos_(position_stiffness) {
+  require(joints_rest_.rows() == Eigen::Index(parents_.size()) && !parents_.empty() && parents_[0] < 0,
+          "Tracking: avatar needs a skeleton with root joint 0 (", joints_rest_.rows(), " rest joints, ",
+          parents_.size(), " parents)");
+  require(k_rot_.size() == parents_.size(), "Tracking: ", k_rot_.size(), " rotation stiffnesses for ",
+          parents_.size(), " joints");
+  for (std::size_t j = 0; j < k_rot_.size(); ++j)
+    require(k_rot_[j] >= 0 && std::isfinite(k_rot_[j]), "Tracking: joint ", j, " stiffness must be >= 0, got ",
+            k_rot_[j]);
+  require(k_pos_ >= 0 && std::isfinite(k_pos_), "Tracking: root position stiffness must be >= 0, got ", k_pos_);
+}
+
+void Tracking::residuals(const StepContext& ctx, const Configuration& q, std::vector<BoneResidual>& out) const {
+  const int J = int(parents_.size());
+  require(int(q.bones.size()) == J, "Tracking: configuration has ", q.bones.size(), " bones, expected ", J);
+  require(ctx.target_pose.axis_angle.rows() == J && ctx.target_pose.axis_angle.allFinite() &&
+              ctx.target_pose.translation.allFinite(),
+          "Tracking: target pose must be finite with ", J, " joint rotations, got ",
+          ctx.target_pose.axis_angle.rows());
+  for (int j = 0; j < J; ++j) {
+    if (k_rot_[j] == 0.0) continue;
+    const Mat3 T = rodrigues(ctx.target_pose.axis_angle.row(j).transpose());
+    out.push_back(rotation_residual(q, j, T.transpose(), parents_[j], k_rot_[j] * Mat3::Identity()));
+  }
+  if (k_pos_ > 0) {
+    const Vec3 root = joints_rest_.row(0).transpose();
+    const Vec3 x = q.bones[0] * root;
+    BoneResidual b;
+    b.r = x - (root + ctx.target_pose.translation);
+    b.W = k_pos_ * Mat3::Identity();
+    b.bones[0] = 0;
+    b.J[0] = point_jacobian(x);
+    out.push_back(b);
+  }
+}
+
+}  // namespace sflsh

@@ -1,0 +1,169 @@
+// Orthotropic Saint Venant–Kirchhoff with Fung saturation and a compression
+// barrier (DESIGN.md §4; Romero et al. 2020, "Modeling and estimation of
+// nonlinear skin mechanics for animated avatars").
+//
+// Ψ(F) = (c/2)(exp(2 Ψ_stvk(Ẽ)/c) − 1) + Ψ_vol(J),   Ẽ = R E Rᵀ,  E = ½(FᵀF − I).
+//
+// Orthotropic stiffness (local axes 1 = along, 2 = through, 3 = around; one
+// Poisson ratio ν for every pair). The compliance uses the geometric-mean rule
+// ν_ij / E_i = ν / √(E_i E_j), which keeps it symmetric:
+//   S_normal = D^{-1/2} A D^{-1/2},  D = diag(E_1, E_2, E_3),  A = (1+ν) I − ν 11ᵀ,
+// A has eigenvalues 1+ν (twice) and 1−2ν, so S (hence C = S⁻¹) is symmetric
+// positive definite for −1 < ν < ½. Inverting in closed form:
+//   C_ij = √(E_i E_j) / (1+ν) · (δ_ij + ν / (1 − 2ν)),
+//   G_ij = √(E_i E_j) / (2(1+ν))          (shear moduli),
+// which for E_1 = E_2 = E_3 is exactly isotropic StVK (C_ii = λ+2μ, C_ij = λ, G = μ).
+//   Ψ_stvk = ½ Σ_ij C_ij Ẽ_ii Ẽ_jj + 2 Σ_{i<j} G_ij Ẽ_ij².
+//
+// Why StVK alone fails under compression: Ψ_stvk is a quartic in F that stays
+// finite as the element collapses (F → 0 gives E → −I/2, a finite energy), its
+// stress vanishes again past ~42% uniaxial compression (the force–stretch curve
+// turns back) and it is symmetric under reflections (Ψ(F) = Ψ(−F)), so a
+// compressed element can snap through and invert at no cost. Fung saturation
+// only rescales Ψ_stvk and inherits this. We add a barrier that is zero up to
+// second order at J = 1 (so the small-strain response is the orthotropic one
+// above) and grows to +∞ as J → 0⁺:
+//   Ψ_vol(J) = κ (−log J + (J − 1) − ½(J − 1)²)  for J < 1,  0 for J ≥ 1,
+// with Ψ_vol''(J) = κ (1/J² − 1) ≥ 0 on (0, 1) (convex in J, C² at J = 1) and
+// κ = Ē / (3(1 − 2ν)) the bulk modulus of the isotropic material with the
+// geometric-mean Young's modulus Ē = (E_1 E_2 E_3)^{1/3}. Ψ = +∞ for J ≤ 0.
+//
+// Overflow guard: exp(x), x = 2Ψ_stvk/c, is continued beyond x_max = 40 by its
+// second-order Taylor polynomial (C², convex, monotone) so extreme strains give
+// huge but finite stresses instead of inf/NaN.
+#include "sflsh/sim/material.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
+
+namespace sflsh {
+namespace {
+
+constexpr double kFungExponentMax = 40.0;
+
+/// 9x9 over column-major vec (index a + 3b) of the orthotropic stiffness in the
+/// local frame: vec(S̃) = C̃ vec(Ẽ) for symmetric Ẽ.
+Mat9 local_stiffness(const RegionMaterial& m) {
+  const double nu = m.poisson;
+  require(nu > -1.0 && nu < 0.5, "material '", m.name, "': poisson = ", nu, ", expected in (-1, 0.5)");
+  require(m.young_along > 0 && m.young_through > 0 && m.young_around > 0, "material '", m.name,
+          "': Young's moduli must be > 0 (got ", m.young_along, ", ", m.young_through, ", ", m.young_around, ")");
+  const double E[3] = {m.young_along, m.young_through, m.young_around};
+  Mat9 C = Mat9::Zero();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double s = std::sqrt(E[i] * E[j]);
+      if (i == j) {
+        for (int k = 0; k < 3; ++k)
+          C(i + 3 * i, k + 3 * k) = std::sqrt(E[i] * E[k]) / (1 + nu) * ((i == k ? 1.0 : 0.0) + nu / (1 - 2 * nu));
+      } else {
+        // Ψ ∋ G_ij (Ẽ_ij² + Ẽ_ji²)  ⇒  S̃_ij = 2 G_ij Ẽ_ij.
+        C(i + 3 * j, i + 3 * j) = 2.0 * s / (2 * (1 + nu));
+      }
+    }
+  return C;
+}
+
+/// Kronecker product A ⊗ B of two 3x3 matrices (9x9): vec(B X Aᵀ) = (A ⊗ B) vec(X).
+Mat9 kron(const Mat3& A, const Mat3& B) {
+  Mat9 K;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) K.block<3, 3>(3 * i, 3 * j) = A(i, j) * B;
+  return K;
+}
+
+Eigen::Map<const Vec9> vec(const Mat3& M) { return Eigen::Map<const Vec9>(M.data()); }
+
+}  // namespace
+
+double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMaterial& material, Mat3* dPsi_dF,
+                             Mat9* d2Psi_dF2, bool project_psd) {
+  const double J = F.determinant();
+  if (!(J > 0.0)) return std::numeric_limits<double>::infinity();
+  require(material.fung_c > 0, "material '", material.name, "': fung_c = ", material.fung_c, ", expected > 0");
+
+  // --- orthotropic StVK in the local frame ---
+  const Mat9 C_local = local_stiffness(material);
+  const Mat9 RR = kron(frame, frame);   // vec(R E Rᵀ) = (R ⊗ R) vec(E)
+  const Mat9 C = RR.transpose() * C_local * RR;  // material-space stiffness: vec(S) = C vec(E)
+  const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
+  Mat3 S;
+  Eigen::Map<Vec9>(S.data()) = C * vec(E);
+  const double psi_stvk = 0.5 * vec(E).dot(vec(S));
+
+  // --- Fung saturation φ(Ψ_s) = (c/2)(exp(2Ψ_s/c) − 1), with the C² Taylor continuation ---
+  const double c = material.fung_c;
+  const double x = 2.0 * psi_stvk / c;
+  double ex, dex, ddex;  // "exp" value and its first/second derivatives in x
+  if (x <= kFungExponentMax) {
+    ex = dex = ddex = std::exp(x);
+  } else {
+    const double e0 = std::exp(kFungExponentMax), d = x - kFungExponentMax;
+    ex = e0 * (1 + d + 0.5 * d * d);
+    dex = e0 * (1 + d);
+    ddex = e0;
+  }
+  const double psi_fung = 0.5 * c * (ex - 1.0);
+  const double dphi = dex;             // dφ/dΨ_s
+  const double ddphi = 2.0 * ddex / c; // d²φ/dΨ_s²
+
+  // --- compression barrier ---
+  const double Ebar = std::cbrt(material.young_along * material.young_through * material.young_around);
+  const double kappa = Ebar / (3.0 * (1.0 - 2.0 * material.poisson));
+  double psi_vol = 0, dvol = 0, ddvol = 0;  // value, d/dJ, d²/dJ²
+  if (J < 1.0) {
+    psi_vol = kappa * (-std::log(J) + (J - 1) - 0.5 * (J - 1) * (J - 1));
+    dvol = kappa * (-1.0 / J + 1.0 - (J - 1));
+    ddvol = kappa * (1.0 / (J * J) - 1.0);
+  }
+
+  if (dPsi_dF || d2Psi_dF2) {
+    const Mat3 P_stvk = F * S;  // first Piola–Kirchhoff stress of StVK
+    // ∂J/∂F = cofactor(F) = J F^{-T}, columns f1 × f2, f2 × f0, f0 × f1.
+    Mat3 cof;
+    cof.col(0) = F.col(1).cross(F.col(2));
+    cof.col(1) = F.col(2).cross(F.col(0));
+    cof.col(2) = F.col(0).cross(F.col(1));
+    if (dPsi_dF) *dPsi_dF = dphi * P_stvk + dvol * cof;
+    if (d2Psi_dF2) {
+      // ∂vec(E)/∂vec(F): ∂E_ab/∂F_cd = ½(δ_ad F_cb + δ_bd F_ca).
+      Mat9 B = Mat9::Zero();
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          for (int cc = 0; cc < 3; ++cc)
+            for (int d = 0; d < 3; ++d) {
+              double v = 0;
+              if (a == d) v += 0.5 * F(cc, b);
+              if (b == d) v += 0.5 * F(cc, a);
+              B(a + 3 * b, cc + 3 * d) = v;
+            }
+      // d vec(F S) = (Sᵀ ⊗ I) vec(dF) + (I ⊗ F) C vec(dE).
+      const Mat9 H_stvk = kron(S.transpose(), Mat3::Identity()) + kron(Mat3::Identity(), F) * C * B;
+      // ∂²J/∂F² (blocks over the columns f0, f1, f2 of F).
+      Mat9 HJ = Mat9::Zero();
+      HJ.block<3, 3>(0, 3) = -hat(F.col(2));
+      HJ.block<3, 3>(0, 6) = hat(F.col(1));
+      HJ.block<3, 3>(3, 0) = hat(F.col(2));
+      HJ.block<3, 3>(3, 6) = -hat(F.col(0));
+      HJ.block<3, 3>(6, 0) = -hat(F.col(1));
+      HJ.block<3, 3>(6, 3) = hat(F.col(0));
+      const Vec9 gP = vec(P_stvk), gJ = vec(cof);
+      Mat9 H = dphi * H_stvk + ddphi * gP * gP.transpose() + ddvol * gJ * gJ.transpose() + dvol * HJ;
+      H = 0.5 * (H + H.transpose()).eval();
+      if (project_psd) {
+        Eigen::SelfAdjointEigenSolver<Mat9> eig(H);
+        const Vec9 lambda = eig.eigenvalues().cwiseMax(0.0);
+        H = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+      }
+      *d2Psi_dF2 = H;
+    }
+  }
+  return psi_fung + psi_vol;
+}
+
+}  // namespace sflsh

@@ -1,0 +1,164 @@
+#include "sflsh/sim/newton_step.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/timer.hpp"
+
+namespace sflsh {
+namespace {
+
+constexpr int kMaxHalvings = 20;
+constexpr double kArmijo = 1e-4;
+
+/// Largest scale ≤ 1 keeping every handle step and bone rotation step within the caps.
+double step_cap(const VecX& delta, const DofLayout& layout, const NewtonOptions& o) {
+  double scale = 1.0;
+  if (o.max_z_step > 0) {
+    double m = 0;
+    for (int k = 0; k < layout.num_reduced / 3; ++k) m = std::max(m, delta.segment<3>(layout.z_offset() + 3 * k).norm());
+    if (m > o.max_z_step) scale = std::min(scale, o.max_z_step / m);
+  }
+  if (o.max_rotation_step > 0 && layout.bones_dynamic) {
+    double m = 0;
+    for (int i = 0; i < layout.num_bones; ++i) m = std::max(m, delta.segment<3>(layout.bone_offset(i)).norm());
+    if (m > o.max_rotation_step) scale = std::min(scale, o.max_rotation_step / m);
+  }
+  return scale;
+}
+
+/// Solves H δ = −g by Cholesky, in place in H (no copy of the ~n² matrix).
+/// Every term's Hessian is PSD and the inertia terms make the sum PD whenever
+/// every DoF carries mass, so no shift is tried first: a constant shift would
+/// bias light DoFs (a finger bone's twist inertia / h² is ~1e-10 of the mean
+/// diagonal). A DoF no term touches (H_ii = 0, so its row is 0 as H is PSD,
+/// e.g. z when the soft-tissue terms are off) gets H_ii = 1: exact, it is
+/// decoupled. If the factorization still fails, each diagonal entry is scaled
+/// by (1 + ε), ε = `eps`·100^k, k = 0..6. H's lower triangle is overwritten;
+/// its strict upper triangle and `diag` keep the original for a retry.
+void solve_in_place(MatX& H, const VecX& g, double eps, VecX& delta, double* shift_used) {
+  for (Eigen::Index i = 0; i < H.rows(); ++i)
+    if (H(i, i) == 0.0) H(i, i) = 1.0;
+  const VecX diag = H.diagonal();
+  double shift = 0;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    if (attempt > 0) {
+      H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+      H.diagonal() = diag + shift * diag.cwiseAbs();
+    }
+    Eigen::LLT<Eigen::Ref<MatX>> llt(H);
+    if (llt.info() == Eigen::Success) {
+      delta = -g;
+      llt.solveInPlace(delta);
+      if (delta.allFinite()) {
+        *shift_used = shift;
+        return;
+      }
+    }
+    shift = attempt == 0 ? eps : shift * 100.0;
+  }
+  fail("newton_minimize: Hessian is not positive definite even with a relative diagonal shift of ", shift / 100.0,
+       "; a DoF without any energy or a NaN in a term?");
+}
+
+}  // namespace
+
+double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, const Configuration& q, VecX* grad,
+                    MatX* hess, std::vector<double>* per_term) {
+  const int n = ctx.layout.size();
+  if (grad) grad->setZero(n);
+  if (hess) hess->setZero(n, n);
+  if (per_term) per_term->clear();
+  double E = 0;
+  for (EnergyTerm* t : terms) {
+    const double e = t->evaluate(ctx, q, grad, hess);
+    if (per_term) per_term->push_back(e);
+    E += e;
+  }
+  return E;
+}
+
+StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, Configuration& q,
+                           const NewtonOptions& o) {
+  require(o.iterations >= 1, "NewtonOptions::iterations = ", o.iterations, ", expected >= 1");
+  Timer total;
+  StepReport rep;
+  VecX g, g_final, delta;
+  MatX H;
+  std::vector<double> per_term;
+  bool final_valid = false;  // g_final/per_term hold the final configuration's values
+  for (int it = 0; it < o.iterations; ++it) {
+    Timer ta;
+    const double E0 = total_energy(terms, ctx, q, &g, &H);
+    rep.ms_assemble += ta.ms();
+    require(std::isfinite(E0) && g.allFinite(), "newton_minimize: energy or gradient is not finite at the start of "
+            "iteration ", it, " (E = ", E0, "); the configuration is inadmissible");
+    const double gnorm = g.norm();
+    if (it == 0) {
+      rep.energy_before = E0;
+      rep.grad_norm_before = gnorm;
+    }
+    if (o.gradient_tolerance > 0 && gnorm <= o.gradient_tolerance) break;
+    ++rep.iterations;
+
+    Timer ts;
+    solve_in_place(H, g, o.regularization, delta, &rep.regularization);
+    rep.ms_solve += ts.ms();
+    const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
+    if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
+
+    double alpha = step_cap(delta, ctx.layout, o);
+    Configuration trial;
+    bool ok = false;
+    Timer tl;
+    // On the last iteration the trial evaluation doubles as the final report's.
+    const bool last = it + 1 == o.iterations && o.report_final;
+    for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
+      trial = retract(q, alpha * delta, ctx.layout);
+      const double E1 = total_energy(terms, ctx, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr);
+      final_valid = last;
+      const bool admissible = std::isfinite(E1);
+      if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * slope) : admissible) {
+        ok = true;
+        break;
+      }
+    }
+    rep.ms_assemble += tl.ms();
+    StepOutcome outcome;
+    if (!ok) {
+      final_valid = false;
+      outcome = StepOutcome::Rejected;
+      ++rep.rejected;
+      rep.step_scale = 0;
+    } else {
+      q = std::move(trial);
+      rep.step_scale = alpha;
+      outcome = alpha == 1.0 ? StepOutcome::Accepted : StepOutcome::Damped;
+      (alpha == 1.0 ? rep.accepted : rep.damped)++;
+    }
+    if (int(outcome) > int(rep.outcome)) rep.outcome = outcome;
+    if (!ok) break;
+  }
+
+  rep.energy_after = rep.grad_norm_after = std::numeric_limits<double>::quiet_NaN();
+  if (o.report_final) {
+    if (!final_valid) {
+      Timer ta;
+      total_energy(terms, ctx, q, &g_final, nullptr, &per_term);
+      rep.ms_assemble += ta.ms();
+    }
+    rep.energy_after = 0;
+    for (double e : per_term) rep.energy_after += e;
+    rep.grad_norm_after = g_final.norm();
+    for (size_t i = 0; i < terms.size(); ++i) rep.energies.push_back({terms[i]->name(), per_term[i]});
+  } else {
+    for (EnergyTerm* t : terms) rep.energies.push_back({t->name(), std::numeric_limits<double>::quiet_NaN()});
+  }
+  rep.ms_total = total.ms();
+  return rep;
+}
+
+}  // namespace sflsh

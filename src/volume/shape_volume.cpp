@@ -1,0 +1,211 @@
+#include "sflsh/volume/shape_volume.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/timer.hpp"
+#include "sflsh/volume/body_regions.hpp"
+#include "sflsh/volume/point_embedding.hpp"
+
+namespace sflsh {
+
+std::string ShapeReport::describe() const {
+  std::ostringstream os;
+  os << quality.describe() << "\n  skin embedding: " << num_embedded_outside
+     << " skin vertices outside the tet mesh, farthest " << max_embedding_distance * 1e3 << " mm; shape stage "
+     << seconds << " s";
+  if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
+  return os.str();
+}
+
+namespace {
+
+// Nodes sharing a tet with each node (sorted, unique).
+std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& tet) {
+  std::vector<std::vector<int>> nbr(tet.num_nodes());
+  for (int t = 0; t < tet.num_elements(); ++t)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (i != j) nbr[tet.elements(t, i)].push_back(tet.elements(t, j));
+  for (auto& n : nbr) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return nbr;
+}
+
+// Per-node thickness scale: the mean of the region scales of the incident
+// tets, then Jacobi-smoothed over the tet graph so the layer thickness varies
+// smoothly across region borders (a step would shear the tets there).
+VecX node_thickness_scale(const TemplateVolume& tv, const ThicknessMap& map, int iterations) {
+  const auto& names = body_region_names();
+  const int N = tv.tet.num_nodes(), T = tv.tet.num_elements();
+  VecX sum = VecX::Zero(N), cnt = VecX::Zero(N);
+  for (int t = 0; t < T; ++t) {
+    const double s = map.scale_of(names[tv.tet_region[t]]);
+    for (int i = 0; i < 4; ++i) sum[tv.tet.elements(t, i)] += s, cnt[tv.tet.elements(t, i)] += 1;
+  }
+  VecX k = sum.cwiseQuotient(cnt.cwiseMax(1.0));
+  const auto nbr = tet_node_neighbours(tv.tet);
+  for (int it = 0; it < iterations; ++it) {
+    VecX next(N);
+    for (int n = 0; n < N; ++n) {
+      double m = 0;
+      for (int u : nbr[n]) m += k[u];
+      next[n] = nbr[n].empty() ? k[n] : 0.5 * k[n] + 0.5 * m / nbr[n].size();
+    }
+    k.swap(next);
+  }
+  return k;
+}
+
+}  // namespace
+
+ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                          const ThicknessMap& thickness, const ShapeOptions& o) {
+  Timer timer;
+  const std::string hash = body_model_hash(model);
+  require(hash == tv.model_hash, "shape_volume: the template volume was built for body model ", tv.model_hash,
+          " but the model given (", model.source, ") has hash ", hash);
+  const int N = tv.tet.num_nodes();
+  const Triangles& F = model.faces;
+  require(tv.node_face.size() == N && tv.node_face.maxCoeff() < F.rows(),
+          "shape_volume: template node faces do not match the model's ", F.rows(), " faces");
+
+  ShapedVolume out;
+  Avatar& av = out.avatar;
+  const Points v_shaped = shape_vertices(model, betas);
+  const Points joints = regress_joints(model, v_shaped);
+
+  // Thickness scale k per node; the depth d' = 1 - k (1 - d) keeps the skin
+  // (d = 1) fixed and scales the soft layer. Thickening is capped per node
+  // so that d' >= min_depth (the layer never reaches past the skeleton
+  // point); nodes already deeper than that keep k <= 1. A global cap would
+  // let the few nodes whose path fit ends at the skeleton (d = 0, near
+  // joints) shrink the layer of the whole body.
+  out.node_thickness_scale = node_thickness_scale(tv, thickness, o.scale_smoothing_iterations);
+  for (int n = 0; n < N; ++n) {
+    const double cap = std::max(1.0, (1.0 - o.min_depth) / std::max(1e-9, 1.0 - tv.node_depth[n]));
+    out.node_thickness_scale[n] = std::min(out.node_thickness_scale[n], cap);
+  }
+
+  // Path end points per node at β = 0 (to carry the residual along) and at β.
+  const Points J0 = regress_joints(model, model.v_template);
+  Points s0(N, 3), g0(N, 3), sb(N, 3), gb(N, 3);
+  for (int n = 0; n < N; ++n) {
+    s0.row(n) = tv.node_skeleton_coefficients.row(n) * J0;
+    sb.row(n) = tv.node_skeleton_coefficients.row(n) * joints;
+    Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const int v = F(tv.node_face[n], i);
+      a += tv.node_face_bary(n, i) * model.v_template.row(v).transpose();
+      b += tv.node_face_bary(n, i) * v_shaped.row(v).transpose();
+    }
+    g0.row(n) = a.transpose();
+    gb.row(n) = b.transpose();
+  }
+  // The residual (the part of the node the path fit does not explain, up to
+  // ~1 cm where paths fan out) rides in the frame of the path: rotated with
+  // it and scaled by its length change. A constant residual would not scale
+  // with the body, and a uniform scale (procedural β0) would then shear and
+  // invert slivers; in the path frame a uniformly scaled body gives exactly
+  // the uniformly scaled mesh.
+  Points residual(N, 3);
+  for (int n = 0; n < N; ++n) {
+    const Vec3 p0 = g0.row(n) - s0.row(n), pb = gb.row(n) - sb.row(n);
+    const Vec3 r0 = tv.node_residual.row(n).transpose();
+    if (p0.norm() < 1e-6 || pb.norm() < 1e-6) {
+      residual.row(n) = r0.transpose();
+      continue;
+    }
+    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(p0, pb);
+    residual.row(n) = (pb.norm() / p0.norm() * (q * r0)).transpose();
+  }
+
+  // Places the nodes for a per-node thickness scale k.
+  av.tet.elements = tv.tet.elements;
+  av.tet.nodes.resize(N, 3);
+  out.node_depth.resize(N);
+  auto place = [&](const VecX& k) {
+    for (int n = 0; n < N; ++n) {
+      const double d = 1.0 - k[n] * (1.0 - tv.node_depth[n]);
+      out.node_depth[n] = d;
+      av.tet.nodes.row(n) = sb.row(n) + d * (gb.row(n) - sb.row(n)) + residual.row(n);
+    }
+  };
+  // Where converging paths (crotch, armpits, between fingers) make the
+  // thickened layer fold or flatten, the thickness scale is relaxed towards 1
+  // around the offending tets (halving the change per round, over a 2-ring
+  // so the relaxation itself varies smoothly). A tet offends if it is
+  // inverted or its smallest dihedral angle falls below both its own at
+  // k = 1 and min_dihedral_deg: the thickness map never makes a tet worse
+  // than that.
+  const VecX k_target = out.node_thickness_scale;
+  place(VecX::Ones(N));
+  std::vector<double> floor_deg(tv.tet.num_elements());
+  for (int t = 0; t < tv.tet.num_elements(); ++t)
+    floor_deg[t] = std::min(o.min_dihedral_deg, tet_quality(av.tet, t).min_dihedral_deg);
+  VecX relax = VecX::Ones(N);
+  std::vector<std::vector<int>> nbr;
+  for (int round = 0;; ++round) {
+    out.node_thickness_scale = (k_target.array() - 1.0) * relax.array() + 1.0;
+    place(out.node_thickness_scale);
+    std::vector<int> bad;
+    for (int t = 0; t < tv.tet.num_elements(); ++t)
+      if (const TetQuality q = tet_quality(av.tet, t); q.signed_volume <= 0 || q.min_dihedral_deg < floor_deg[t] - 1e-9)
+        bad.push_back(t);
+    if (bad.empty() || round >= o.max_relax_rounds) break;
+    if (nbr.empty()) nbr = tet_node_neighbours(tv.tet);
+    std::vector<char> mark(N, 0);
+    for (int t : bad)
+      for (int i = 0; i < 4; ++i) mark[tv.tet.elements(t, i)] = 1;
+    for (int ring = 0; ring < 2; ++ring) {
+      std::vector<char> next = mark;
+      for (int n = 0; n < N; ++n)
+        if (mark[n])
+          for (int u : nbr[n]) next[u] = 1;
+      mark.swap(next);
+    }
+    const bool last = round + 1 >= o.max_relax_rounds;
+    for (int n = 0; n < N; ++n)
+      if (mark[n]) relax[n] = last ? 0.0 : 0.5 * relax[n];
+  }
+  for (int n = 0; n < N; ++n) out.report.num_relaxed_nodes += relax[n] < 1.0;
+  out.report.quality = tet_quality_report(av.tet);
+  require(out.report.quality.num_inverted == 0, "shape_volume: ", out.report.quality.num_inverted,
+          " tets inverted for this shape (smallest volume ", out.report.quality.min_volume,
+          " m^3) even with the thickness map relaxed to 1 around them; reduce |betas|");
+
+  // Meta, skeleton, skin.
+  av.betas = betas;
+  av.model_hash = hash;
+  av.model_source = model.source;
+  av.joints_rest = joints;
+  av.parents = model.parents;
+  av.joint_names = model.joint_names;
+  av.surface_rest = v_shaped;
+  av.surface_faces = F;
+  av.surface_weights = model.weights;
+  if (model.has_pose_blend_shapes()) av.surface_posedirs = model.posedirs;
+  const PointEmbedding emb = embed_points(av.tet, v_shaped);
+  av.surface_tet = emb.tet;
+  av.surface_bary = emb.bary;
+  out.report.max_embedding_distance = emb.distance.maxCoeff();
+  out.report.num_embedded_outside = emb.num_outside;
+
+  // Volume fields.
+  av.node_weights = tv.node_weights;
+  av.node_role = tv.node_role;
+  av.surface_nodes = tv.outer_nodes;
+  av.tet_region = tv.tet_region;
+  av.materials = default_region_materials();
+  av.tet_frames = tet_frames(av.tet, sb, tv.node_segment, tv.segments, model.parents, joints);
+  av.capsules = fit_bone_capsules(av.tet.nodes, sb, tv.outer_nodes, tv.node_segment, tv.segments,
+                                  model.parents, joints, o.capsule_percentile);
+  out.report.seconds = timer.seconds();
+  return out;
+}
+
+}  // namespace sflsh

@@ -1,0 +1,88 @@
+#include "sflsh/sim/energies/tracking.hpp"
+
+#include <gtest/gtest.h>
+
+#include "sflsh/sim/skeleton_pose.hpp"
+#include "skeleton_fixture.hpp"
+
+namespace sflsh {
+namespace {
+
+std::vector<double> stiffness_ramp() {
+  std::vector<double> k(24);
+  for (int j = 0; j < 24; ++j) k[j] = 10.0 + 3.0 * j;
+  return k;
+}
+
+TEST(Tracking, ZeroAtTheTarget) {
+  const Avatar a = test::make_tpose_skeleton();
+  Tracking term(a, stiffness_ramp(), 1e4);
+  std::mt19937 rng(41);
+  StepContext ctx = test::skeleton_context(a, test::random_bones(rng, 0.3, 0.1));
+  ctx.target_pose = test::random_pose(rng, 1.2);
+  const Configuration q =
+      test::bones_config(bone_transforms_from_pose(a.joints_rest, a.parents, ctx.target_pose));
+  VecX g = VecX::Zero(ctx.layout.size());
+  EXPECT_LT(term.evaluate(ctx, q, &g, nullptr), 1e-20);
+  EXPECT_LT(g.norm(), 1e-9);
+}
+
+TEST(Tracking, SpringValues) {
+  // One joint off its target by α about an axis: ½ k_j α²; root off by d: ½ k_pos |d|².
+  const Avatar a = test::make_tpose_skeleton();
+  const std::vector<double> k = stiffness_ramp();
+  Tracking term(a, k, 1e4);
+  StepContext ctx = test::skeleton_context(a, test::bones_config(std::vector<Isometry>(24, Isometry::Identity())));
+  ctx.target_pose.axis_angle.row(16) << 0.1, -0.4, -1.0;
+  ctx.target_pose.translation << 0.0, 0.1, 0.5;
+  BodyPose pose = ctx.target_pose;
+  pose.axis_angle.row(16) =
+      rotation_log(rodrigues(ctx.target_pose.axis_angle.row(16).transpose()) * rodrigues(Vec3(0, 0, 0.3)))
+          .transpose();  // rotated 0.3 rad further
+  pose.translation += Vec3(0.01, 0.0, -0.02);
+  const Configuration q = test::bones_config(bone_transforms_from_pose(a.joints_rest, a.parents, pose));
+  EXPECT_NEAR(term.evaluate(ctx, q, nullptr, nullptr), 0.5 * k[16] * 0.09 + 0.5 * 1e4 * 5e-4, 1e-12);
+}
+
+TEST(Tracking, DerivativesMatchFiniteDifferences) {
+  const Avatar a = test::make_tpose_skeleton();
+  Tracking term(a, stiffness_ramp(), 1e4);
+  std::mt19937 rng(42);
+  const int n = 6 * 24;
+  StepContext ctx = test::skeleton_context(a, test::random_bones(rng, 0.3, 0.1));
+  ctx.target_pose = test::random_pose(rng, 0.8);
+  const Configuration q = test::random_bones(rng, 1.0, 0.3);
+  VecX g = VecX::Zero(n);
+  MatX H = MatX::Zero(n, n);
+  term.evaluate(ctx, q, &g, &H);
+  EXPECT_LT(test::rel_error(g, test::fd_gradient(term, ctx, q)), 1e-6);
+  VecX r;
+  MatX J;
+  test::stacked_residuals(term, ctx, q, r, &J);
+  EXPECT_EQ(r.size(), 3 * 25);
+  EXPECT_LT(test::rel_error(J, test::fd_residual_jacobian(term, ctx, q)), 1e-7);
+  EXPECT_GT(test::min_eigenvalue(H), -1e-9 * H.norm());
+
+  // At the target (zero residual) Gauss–Newton is the exact Hessian.
+  const Configuration q0 =
+      test::bones_config(bone_transforms_from_pose(a.joints_rest, a.parents, ctx.target_pose));
+  MatX H0 = MatX::Zero(n, n);
+  term.evaluate(ctx, q0, nullptr, &H0);
+  EXPECT_LT(test::rel_error(H0, test::fd_hessian(term, ctx, q0)), 1e-5);
+}
+
+TEST(Tracking, RejectsBadTargets) {
+  const Avatar a = test::make_tpose_skeleton();
+  Tracking term(a, stiffness_ramp(), 1e4);
+  const Configuration rest = test::bones_config(std::vector<Isometry>(24, Isometry::Identity()));
+  StepContext ctx = test::skeleton_context(a, rest);
+  ctx.target_pose.axis_angle.resize(23, 3);
+  EXPECT_THROW(term.evaluate(ctx, rest, nullptr, nullptr), Error);
+  ctx.target_pose = BodyPose{};
+  ctx.target_pose.translation.x() = std::nan("");
+  EXPECT_THROW(term.evaluate(ctx, rest, nullptr, nullptr), Error);
+  EXPECT_THROW(Tracking(a, std::vector<double>(24, -1.0), 1.0), Error);
+}
+
+}  // namespace
+}  // namespace sflsh
