@@ -1,7 +1,12 @@
 #pragma once
 // Helpers shared by the test executables.
+#include <gtest/gtest.h>
+
 #include <filesystem>
+#include <initializer_list>
 #include <string>
+
+#include "sflsh/core/error.hpp"
 
 namespace sflsh::test {
 
@@ -24,6 +29,20 @@ std::string shared_data(const std::string& rel);
 /// The repository's source folder and the built sflsh executable.
 std::string source_dir();
 std::string sflsh_binary();
+
+/// Path of a committed fixture in tests/data/.
+inline std::string fixture(const std::string& name) { return source_dir() + "/tests/data/" + name; }
+
+/// Expects `fn` to throw sflsh::Error whose message contains every fragment.
+template <class Fn>
+void expect_error(Fn fn, std::initializer_list<std::string> fragments) {
+  try {
+    fn();
+    ADD_FAILURE() << "no error thrown";
+  } catch (const Error& e) {
+    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+  }
+}
 
 /// Runs a shell command, returns its exit code; stdout+stderr go to *output.
 int run_command(const std::string& cmd, std::string* output = nullptr);

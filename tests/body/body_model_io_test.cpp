@@ -22,17 +22,9 @@ namespace {
 using test::TempDir;
 using NpzArrays = std::map<std::string, io::NpyArray>;
 
-std::string fixture(const std::string& name) { return test::source_dir() + "/tests/data/" + name; }
+using test::fixture;
 
-template <class Fn>
-void expect_error(Fn fn, std::initializer_list<std::string> fragments) {
-  try {
-    fn();
-    ADD_FAILURE() << "no error thrown";
-  } catch (const Error& e) {
-    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-  }
-}
+using test::expect_error;
 
 void expect_same_model(const BodyModel& a, const BodyModel& b) {
   EXPECT_EQ(a.v_template, b.v_template);

@@ -20,17 +20,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string fixture(const std::string& name) { return test::source_dir() + "/tests/data/" + name; }
+using test::fixture;
 
-template <class Fn>
-void expect_error(Fn fn, std::initializer_list<std::string> fragments) {
-  try {
-    fn();
-    ADD_FAILURE() << "no error thrown";
-  } catch (const Error& e) {
-    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-  }
-}
+using test::expect_error;
 
 // A 24-joint model whose first 24 vertices sit at the joints `J` (weight 1 to
 // their own joint, regressor = identity on them), plus `extra` vertices with

@@ -19,7 +19,7 @@ namespace {
 
 using test::TempDir;
 
-std::string fixture(const std::string& name) { return test::source_dir() + "/tests/data/" + name; }
+using test::fixture;
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -54,16 +54,7 @@ std::string raw(std::initializer_list<T> values, bool big_endian = false) {
   return out;
 }
 
-// Expects `fn` to throw sflsh::Error whose message contains every fragment.
-template <class Fn>
-void expect_error(Fn fn, std::initializer_list<std::string> fragments) {
-  try {
-    fn();
-    ADD_FAILURE() << "no error thrown";
-  } catch (const Error& e) {
-    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
-  }
-}
+using test::expect_error;
 
 TEST(Npz, RoundTripStoredAndDeflated) {
   TempDir dir;
