@@ -51,6 +51,12 @@ std::string SimulationResult::describe() const {
     << ", " << newton_iters << " Newton iteration(s) per step), " << num_frames << " frames\n"
     << "steps: " << accepted << " accepted, " << damped << " damped, " << rejected << " rejected; step time median "
     << median_step_ms() << " ms, p95 " << p95_step_ms() << " ms\n";
+  if (!part_names.empty() && !step_ms.empty()) {
+    o << "mean ms per step:";
+    for (size_t i = 0; i < part_names.size(); ++i)
+      o << (i ? ", " : " ") << part_names[i] << " " << part_ms[i] / double(step_ms.size());
+    o << "\n";
+  }
   return o.str();
 }
 
@@ -113,6 +119,13 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     r.step_decrement.push_back(rep.newton_decrement);
     r.step_outcome.push_back(int(rep.outcome));
     r.step_ms.push_back(rep.ms_total);
+    if (r.part_names.empty()) {
+      for (const TermEnergy& e : rep.energies) r.part_names.push_back(e.name);
+      r.part_names.push_back("solve");
+      r.part_ms.assign(r.part_names.size(), 0.0);
+    }
+    for (size_t i = 0; i < rep.energies.size() && i + 1 < r.part_ms.size(); ++i) r.part_ms[i] += rep.energies[i].ms;
+    r.part_ms.back() += rep.ms_solve;
     r.accepted += rep.accepted;
     r.damped += rep.damped;
     r.rejected += rep.rejected;

@@ -93,9 +93,9 @@ FullFem::FullFem(std::shared_ptr<const Avatar> avatar, FullFemOptions options)
     Mat3 D;
     for (int c = 1; c < 4; ++c) D.col(c - 1) = (a.tet.nodes.row(a.tet.elements(t, c)) - a.tet.nodes.row(a.tet.elements(t, 0))).transpose();
     volume_[t] = D.determinant() / 6.0;
-    frames_.push_back(tet_frame(a, t));
-    materials_.push_back(&tet_material(a, t));
-    for (int c = 0; c < 4; ++c) mass_[a.tet.elements(t, c)] += materials_.back()->density * volume_[t] / 4.0;
+    const RegionMaterial& material = tet_material(a, t);
+    materials_.emplace_back(material, tet_frame(a, t));
+    for (int c = 0; c < 4; ++c) mass_[a.tet.elements(t, c)] += material.density * volume_[t] / 4.0;
   }
 
   // Sparsity pattern (lower triangle) and the value slot of every contribution.
@@ -185,8 +185,8 @@ double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
     for (int c = 0; c < 4; ++c) F += u.row(a.tet.elements(t, c)).transpose() * grads_.block<1, 3>(t, 3 * c);
     Mat3 P;
     Mat9 H9;
-    const double psi = strain_energy_density(F, frames_[t], *materials_[t], grad ? &P : nullptr,
-                                             hessian ? &H9 : nullptr, true);
+    const double psi = strain_energy_density(F, materials_[t], grad ? &P : nullptr,
+                                             hessian ? &H9 : nullptr, project_hessian_);
     if (!std::isfinite(psi)) return std::numeric_limits<double>::infinity();
     E += volume_[t] * psi;
     if (grad)
@@ -239,7 +239,18 @@ FullFemReport FullFem::step(const std::vector<Isometry>& bones_next) {
       break;
     }
     Timer tf;
-    if (!chol_->factorize()) {
+    // The exact Hessian converges quadratically and is positive definite unless
+    // compression outweighs the lumped masses / h²; then the elements' PSD
+    // majorizers (sim/material.hpp) make it so for this iteration.
+    bool factorized = chol_->factorize();
+    if (!factorized) {
+      project_hessian_ = true;
+      evaluate(u_, &g, true);
+      project_hessian_ = false;
+      factorized = chol_->factorize();
+      ++rep.projected_iterations;
+    }
+    if (!factorized) {
       // PSD elasticity + positive lumped masses make H positive definite; a failure
       // means a degenerate mass or NaN, which regularization would only hide.
       fail("FullFem::step: Hessian not positive definite at t = ", time_, " (CHOLMOD status ", chol_->common.status,

@@ -79,22 +79,52 @@ Mat9 kron(const Mat3& A, const Mat3& B) {
 
 Eigen::Map<const Vec9> vec(const Mat3& M) { return Eigen::Map<const Vec9>(M.data()); }
 
+/// Voigt index pairs: e_p = E(a_p, b_p).
+constexpr int kVoigtA[6] = {0, 1, 2, 0, 0, 1};
+constexpr int kVoigtB[6] = {0, 1, 2, 1, 2, 2};
+
+/// [A]₊: A (symmetric 3x3) with its negative eigenvalues set to 0.
+Mat3 positive_part(const Mat3& A) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(A);
+  if (eig.eigenvalues().minCoeff() >= 0.0) return A;
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+}
+
 }  // namespace
+
+MaterialPoint::MaterialPoint(const RegionMaterial& m, const Mat3& frame) {
+  require(m.fung_c > 0, "material '", m.name, "': fung_c = ", m.fung_c, ", expected > 0");
+  const Mat9 RR = kron(frame, frame);                   // vec(R E Rᵀ) = (R ⊗ R) vec(E)
+  const Mat9 C = RR.transpose() * local_stiffness(m) * RR;  // material space: vec(S) = C vec(E)
+  // Voigt: vec(E) = M e with E01 = E10 = e_3 etc., so Ψ = ½ eᵀ (Mᵀ C M) e.
+  Eigen::Matrix<double, 9, 6> M = Eigen::Matrix<double, 9, 6>::Zero();
+  for (int p = 0; p < 6; ++p) {
+    M(kVoigtA[p] + 3 * kVoigtB[p], p) = 1.0;
+    M(kVoigtB[p] + 3 * kVoigtA[p], p) = 1.0;
+  }
+  stiffness = M.transpose() * C * M;
+  fung_c = m.fung_c;
+  const double Ebar = std::cbrt(m.young_along * m.young_through * m.young_around);
+  kappa = Ebar / (3.0 * (1.0 - 2.0 * m.poisson));
+}
 
 double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMaterial& material, Mat3* dPsi_dF,
                              Mat9* d2Psi_dF2, bool project_psd) {
+  return strain_energy_density(F, MaterialPoint(material, frame), dPsi_dF, d2Psi_dF2, project_psd);
+}
+
+double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3* dPsi_dF, Mat9* d2Psi_dF2,
+                             bool project_psd) {
   const double J = F.determinant();
   if (!(J > 0.0)) return std::numeric_limits<double>::infinity();
-  require(material.fung_c > 0, "material '", material.name, "': fung_c = ", material.fung_c, ", expected > 0");
 
-  // --- orthotropic StVK in the local frame ---
-  const Mat9 C_local = local_stiffness(material);
-  const Mat9 RR = kron(frame, frame);   // vec(R E Rᵀ) = (R ⊗ R) vec(E)
-  const Mat9 C = RR.transpose() * C_local * RR;  // material-space stiffness: vec(S) = C vec(E)
-  const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-  Mat3 S;
-  Eigen::Map<Vec9>(S.data()) = C * vec(E);
-  const double psi_stvk = 0.5 * vec(E).dot(vec(S));
+  // --- orthotropic StVK, Voigt ---
+  const Mat3 FtF = F.transpose() * F;
+  Vec6 e;
+  for (int p = 0; p < 6; ++p) e[p] = 0.5 * (FtF(kVoigtA[p], kVoigtB[p]) - (p < 3 ? 1.0 : 0.0));
+  const Vec6 s6 = material.stiffness * e;  // ∂Ψ_stvk/∂e
+  const double psi_stvk = 0.5 * e.dot(s6);
 
   // --- Fung saturation φ(Ψ_s) = (c/2)(exp(2Ψ_s/c) − 1), with the C² Taylor continuation ---
   const double c = material.fung_c;
@@ -113,8 +143,7 @@ double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMater
   const double ddphi = 2.0 * ddex / c; // d²φ/dΨ_s²
 
   // --- compression barrier ---
-  const double Ebar = std::cbrt(material.young_along * material.young_through * material.young_around);
-  const double kappa = Ebar / (3.0 * (1.0 - 2.0 * material.poisson));
+  const double kappa = material.kappa;
   double psi_vol = 0, dvol = 0, ddvol = 0;  // value, d/dJ, d²/dJ²
   if (J < 1.0) {
     psi_vol = kappa * (-std::log(J) + (J - 1) - 0.5 * (J - 1) * (J - 1));
@@ -123,6 +152,12 @@ double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMater
   }
 
   if (dPsi_dF || d2Psi_dF2) {
+    // Second Piola–Kirchhoff stress: S_aa = s_p, S_ab = S_ba = s_p / 2 (E_ab appears twice in vec(E)).
+    Mat3 S;
+    for (int p = 0; p < 6; ++p) {
+      const double v = p < 3 ? s6[p] : 0.5 * s6[p];
+      S(kVoigtA[p], kVoigtB[p]) = S(kVoigtB[p], kVoigtA[p]) = v;
+    }
     const Mat3 P_stvk = F * S;  // first Piola–Kirchhoff stress of StVK
     // ∂J/∂F = cofactor(F) = J F^{-T}, columns f1 × f2, f2 × f0, f0 × f1.
     Mat3 cof;
@@ -131,19 +166,18 @@ double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMater
     cof.col(2) = F.col(0).cross(F.col(1));
     if (dPsi_dF) *dPsi_dF = dphi * P_stvk + dvol * cof;
     if (d2Psi_dF2) {
-      // ∂vec(E)/∂vec(F): ∂E_ab/∂F_cd = ½(δ_ad F_cb + δ_bd F_ca).
-      Mat9 B = Mat9::Zero();
+      // B = ∂e/∂vec(F) (6x9): ∂E_ab/∂f_a = ½ f_b, ∂E_ab/∂f_b = ½ f_a (f_a = column a of F).
+      Eigen::Matrix<double, 6, 9> B = Eigen::Matrix<double, 6, 9>::Zero();
+      for (int p = 0; p < 6; ++p) {
+        const int a = kVoigtA[p], b = kVoigtB[p];
+        B.block<1, 3>(p, 3 * a) += 0.5 * F.col(b).transpose();
+        B.block<1, 3>(p, 3 * b) += 0.5 * F.col(a).transpose();
+      }
+      // ∂²Ψ_stvk/∂F² = S ⊗ I (from dF S) + Bᵀ C B (from F dS). Projected: [S]₊ ⊗ I.
+      Mat9 H_stvk = B.transpose() * (material.stiffness * B);
+      const Mat3 S_geometric = project_psd ? positive_part(S) : S;
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          for (int cc = 0; cc < 3; ++cc)
-            for (int d = 0; d < 3; ++d) {
-              double v = 0;
-              if (a == d) v += 0.5 * F(cc, b);
-              if (b == d) v += 0.5 * F(cc, a);
-              B(a + 3 * b, cc + 3 * d) = v;
-            }
-      // d vec(F S) = (Sᵀ ⊗ I) vec(dF) + (I ⊗ F) C vec(dE).
-      const Mat9 H_stvk = kron(S.transpose(), Mat3::Identity()) + kron(Mat3::Identity(), F) * C * B;
+        for (int b = 0; b < 3; ++b) H_stvk.block<3, 3>(3 * a, 3 * b).diagonal().array() += S_geometric(a, b);
       // ∂²J/∂F² (blocks over the columns f0, f1, f2 of F).
       Mat9 HJ = Mat9::Zero();
       HJ.block<3, 3>(0, 3) = -hat(F.col(2));
@@ -154,13 +188,10 @@ double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMater
       HJ.block<3, 3>(6, 3) = hat(F.col(0));
       const Vec9 gP = vec(P_stvk), gJ = vec(cof);
       Mat9 H = dphi * H_stvk + ddphi * gP * gP.transpose() + ddvol * gJ * gJ.transpose() + dvol * HJ;
-      H = 0.5 * (H + H.transpose()).eval();
-      if (project_psd) {
-        Eigen::SelfAdjointEigenSolver<Mat9> eig(H);
-        const Vec9 lambda = eig.eigenvalues().cwiseMax(0.0);
-        H = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
-      }
-      *d2Psi_dF2 = H;
+      // dvol ≤ 0 (J + 1/J ≥ 2) and ∂²J/∂F² is indefinite with spectral radius
+      // ≤ σ_a + σ_b (two largest singular values; Smith et al. 2019) ≤ √2 ‖F‖_F.
+      if (project_psd && dvol < 0) H.diagonal().array() += -dvol * std::sqrt(2.0) * F.norm();
+      *d2Psi_dF2 = 0.5 * (H + H.transpose());
     }
   }
   return psi_fung + psi_vol;

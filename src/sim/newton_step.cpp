@@ -67,14 +67,17 @@ void solve_in_place(MatX& H, const VecX& g, double eps, VecX& delta, double* shi
 }  // namespace
 
 double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, const Configuration& q, VecX* grad,
-                    MatX* hess, std::vector<double>* per_term) {
+                    MatX* hess, std::vector<double>* per_term, std::vector<double>* term_ms) {
   const int n = ctx.layout.size();
   if (grad) grad->setZero(n);
   if (hess) hess->setZero(n, n);
   if (per_term) per_term->clear();
+  if (term_ms) term_ms->resize(terms.size(), 0.0);
   double E = 0;
-  for (EnergyTerm* t : terms) {
-    const double e = t->evaluate(ctx, q, grad, hess);
+  for (size_t i = 0; i < terms.size(); ++i) {
+    Timer timer;
+    const double e = terms[i]->evaluate(ctx, q, grad, hess);
+    if (term_ms) (*term_ms)[i] += timer.ms();
     if (per_term) per_term->push_back(e);
     E += e;
   }
@@ -88,11 +91,11 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
   StepReport rep;
   VecX g, g_final, delta;
   MatX H;
-  std::vector<double> per_term;
+  std::vector<double> per_term, term_ms;
   bool final_valid = false;  // g_final/per_term hold the final configuration's values
   for (int it = 0; it < o.iterations; ++it) {
     Timer ta;
-    const double E0 = total_energy(terms, ctx, q, &g, &H);
+    const double E0 = total_energy(terms, ctx, q, &g, &H, nullptr, &term_ms);
     rep.ms_assemble += ta.ms();
     require(std::isfinite(E0) && g.allFinite(), "newton_minimize: energy or gradient is not finite at the start of "
             "iteration ", it, " (E = ", E0, "); the configuration is inadmissible");
@@ -118,7 +121,8 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
     const bool last = it + 1 == o.iterations && o.report_final;
     for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
       trial = retract(q, alpha * delta, ctx.layout);
-      const double E1 = total_energy(terms, ctx, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr);
+      const double E1 = total_energy(terms, ctx, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr,
+                                     &term_ms);
       final_valid = last;
       const bool admissible = std::isfinite(E1);
       if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * slope) : admissible) {
@@ -147,15 +151,16 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
   if (o.report_final) {
     if (!final_valid) {
       Timer ta;
-      total_energy(terms, ctx, q, &g_final, nullptr, &per_term);
+      total_energy(terms, ctx, q, &g_final, nullptr, &per_term, &term_ms);
       rep.ms_assemble += ta.ms();
     }
     rep.energy_after = 0;
     for (double e : per_term) rep.energy_after += e;
     rep.grad_norm_after = g_final.norm();
-    for (size_t i = 0; i < terms.size(); ++i) rep.energies.push_back({terms[i]->name(), per_term[i]});
+    for (size_t i = 0; i < terms.size(); ++i) rep.energies.push_back({terms[i]->name(), per_term[i], term_ms[i]});
   } else {
-    for (EnergyTerm* t : terms) rep.energies.push_back({t->name(), std::numeric_limits<double>::quiet_NaN()});
+    for (size_t i = 0; i < terms.size(); ++i)
+      rep.energies.push_back({terms[i]->name(), std::numeric_limits<double>::quiet_NaN(), term_ms[i]});
   }
   rep.ms_total = total.ms();
   return rep;

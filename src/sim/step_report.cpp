@@ -21,7 +21,9 @@ std::string StepReport::summary() const {
      << grad_norm_after << ", Newton decrement " << newton_decrement << ", step scale " << step_scale << "\n";
   os << "  terms:";
   for (const auto& e : energies) os << " " << e.name << "=" << e.value;
-  os << "\n  time " << ms_total << " ms (assemble " << ms_assemble << ", solve " << ms_solve << ")\n";
+  os << "\n  time " << ms_total << " ms (assemble " << ms_assemble << ", solve " << ms_solve << "; per term:";
+  for (const auto& e : energies) os << " " << e.name << " " << e.ms;
+  os << ")\n";
   return os.str();
 }
 

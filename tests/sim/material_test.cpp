@@ -139,5 +139,29 @@ TEST(Material, ProjectedHessianIsPositiveSemidefinite) {
   EXPECT_GT(indefinite, 0) << "test never exercised the projection";
 }
 
+TEST(Material, ProjectedHessianMajorizesTheExactOne) {
+  std::mt19937 rng(11);
+  const RegionMaterial m = test_material();
+  int compressed = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Mat3 F = random_F(rng, 0.4), R = random_rotation(rng);
+    if (F.determinant() <= 0) continue;
+    Mat9 H, Hp;
+    strain_energy_density(F, R, m, nullptr, &H, false);
+    strain_energy_density(F, R, m, nullptr, &Hp, true);
+    if (F.determinant() < 1) ++compressed;
+    // H⁺ − H ⪰ 0: a Newton step with H⁺ is never longer along any direction.
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Mat9>(Hp - H).eigenvalues().minCoeff(), -1e-9 * H.norm()) << "trial " << trial;
+  }
+  EXPECT_GT(compressed, 5) << "test never exercised the barrier";
+  // Stretching in every material direction (S ⪰ 0, J > 1): nothing to project.
+  const Mat3 R = random_rotation(rng);
+  const Mat3 F = R * Vec3(1.1, 1.2, 1.05).asDiagonal() * R.transpose();
+  Mat9 H, Hp;
+  strain_energy_density(F, Mat3::Identity(), m, nullptr, &H, false);
+  strain_energy_density(F, Mat3::Identity(), m, nullptr, &Hp, true);
+  EXPECT_LT((Hp - H).norm(), 1e-12 * H.norm());
+}
+
 }  // namespace
 }  // namespace sflsh

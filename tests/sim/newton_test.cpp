@@ -84,7 +84,9 @@ TEST(Simulator, FreeFallOfTheWholeBodyMatchesGravity) {
     const StepReport rep = sim.step(identity_bones());
     ASSERT_NE(rep.outcome, StepOutcome::Rejected);
     const Vec3 c = centre_of_mass(*a, sim.state());
-    if (i >= 2) EXPECT_LT(((c - 2 * c_prev + c_prev2) / (o.h * o.h) - o.gravity).norm(), 1e-6) << "step " << i;
+    if (i >= 2) {
+      EXPECT_LT(((c - 2 * c_prev + c_prev2) / (o.h * o.h) - o.gravity).norm(), 1e-6) << "step " << i;
+    }
     c_prev2 = c_prev;
     c_prev = c;
   }

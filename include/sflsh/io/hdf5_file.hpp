@@ -8,6 +8,7 @@
 // Writing goes to "<path>.partial" and is renamed over <path> by commit(), so a
 // failed or interrupted job never leaves a half-written file behind.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -94,6 +95,11 @@ class Hdf5File {
   Mode mode_;
   long file_ = -1;  // hid_t
   bool committed_ = false;
+  // Appendable datasets stay open until commit/destruction so that HDF5's
+  // chunk cache keeps a partly filled chunk in memory: reopening per append
+  // flushed (deflated) and re-read (inflated) it on every frame.
+  std::map<std::string, long> appendable_;  // name -> hid_t
+  void close_appendable();
 };
 
 }  // namespace sflsh::io

@@ -64,6 +64,10 @@ struct SimulationResult {
   std::vector<int> step_outcome;
   int num_frames = 0;  ///< output frames made (kept or not)
   int accepted = 0, damped = 0, rejected = 0;
+  /// Where the step time goes: each energy term's evaluations and the
+  /// Cholesky solve, summed over all steps (ms), in the step's term order.
+  std::vector<std::string> part_names;
+  std::vector<double> part_ms;
 
   /// Median / 95th percentile step wall time (ms).
   double median_step_ms() const;

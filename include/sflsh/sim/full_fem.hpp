@@ -15,6 +15,7 @@
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/sim/configuration.hpp"
+#include "sflsh/sim/material.hpp"
 #include "sflsh/sim/posed_points.hpp"
 
 namespace sflsh {
@@ -32,6 +33,7 @@ struct FullFemOptions {
 
 struct FullFemReport {
   int iterations = 0;          ///< Newton iterations taken
+  int projected_iterations = 0;  ///< of which the exact Hessian was indefinite (PSD element majorizers used)
   bool converged = false;
   double grad_norm_initial = 0, grad_norm = 0;  ///< N
   double energy = 0;           ///< J, at the end
@@ -77,8 +79,8 @@ class FullFem {
   VecX mass_;                        // #N lumped masses (kg)
   VecX volume_;                      // #T
   MatXr grads_;                      // #T by 12 shape gradients
-  std::vector<Mat3> frames_;
-  std::vector<const RegionMaterial*> materials_;
+  std::vector<MaterialPoint> materials_;
+  bool project_hessian_ = false;  // element Hessians: exact, or PSD majorizers  // #T, region material in the tet's frame
   std::vector<int> tet_slot_;        // #T·144: value index in the lower CSC or −1
   std::vector<int> node_slot_;       // #free·9: value index of the diagonal inertia block or −1
   std::unique_ptr<Cholmod> chol_;

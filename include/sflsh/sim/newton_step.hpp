@@ -40,8 +40,10 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
                            const NewtonOptions& options);
 
 /// Total energy Σ terms at q, adding gradient/Hessian when non-null (sized and
-/// zeroed here); per-term values go to `per_term` when non-null.
+/// zeroed here); per-term values go to `per_term` when non-null, and each
+/// term's evaluation time (ms) is added to `term_ms` (sized to #terms) when non-null.
 double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, const Configuration& q,
-                    VecX* grad, MatX* hess, std::vector<double>* per_term = nullptr);
+                    VecX* grad, MatX* hess, std::vector<double>* per_term = nullptr,
+                    std::vector<double>* term_ms = nullptr);
 
 }  // namespace sflsh

@@ -20,6 +20,7 @@ const char* to_string(StepOutcome outcome);
 struct TermEnergy {
   std::string name;
   double value = 0;  ///< J, at the end of the step
+  double ms = 0;     ///< time spent evaluating this term during the step (all evaluations)
 };
 
 struct StepReport {

@@ -4,9 +4,6 @@
 #include <limits>
 #include <map>
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
-
 #include "sflsh/core/error.hpp"
 
 namespace sflsh {
@@ -87,8 +84,7 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd) : num_reduced_(a.num
       d_.push_back(v);
     }
     start_.push_back(int(handle_.size()));
-    frame_.push_back(tet_frame(a, t));
-    material_.push_back(&tet_material(a, t));
+    material_.emplace_back(tet_material(a, t), tet_frame(a, t));
   }
 }
 
@@ -106,72 +102,39 @@ double ElasticTerm::min_det(const VecX& z) const {
 
 double ElasticTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
   require(q.z.size() == num_reduced_, "ElasticTerm: z has ", q.z.size(), " entries, expected ", num_reduced_);
-  const int z0 = ctx.layout.z_offset(), r = num_reduced_, S = num_samples();
-  // Projected Hessian as Σ_k Y_kᵀ Y_k, Y_k = Lᵀ G_k (9 by 3m_k) with
-  // c_k ΠPSD(∂²Ψ/∂F²) = L Lᵀ. Dense basis: stack the Y_k and do one symmetric
-  // rank-9S update over all of z; sparse basis: form each Y_kᵀ Y_k and scatter.
-  double local_cost = 0;
-  for (int k = 0; k < S; ++k) local_cost += std::pow(3.0 * (start_[k + 1] - start_[k]), 2);
-  const bool dense = local_cost >= 0.3 * double(S) * r * r;
-  MatX Y;
-  if (hess && project_psd_ && dense) Y.setZero(9 * S, r);
-  MatX Yk, YtY;  // per-sample buffers, reused
+  const int z0 = ctx.layout.z_offset(), S = num_samples();
   double E = 0;
+  std::vector<Eigen::Matrix<double, 3, 9>> T;  // per handle of the sample, reused
   for (int k = 0; k < S; ++k) {
     const Mat3 F = deformation_gradient(k, q.z);
     Mat3 P;
     Mat9 H;
-    const double psi = strain_energy_density(F, frame_[k], *material_[k], grad ? &P : nullptr,
-                                             hess ? &H : nullptr, false);
+    const double psi = strain_energy_density(F, material_[k], grad ? &P : nullptr, hess ? &H : nullptr, project_psd_);
     if (!std::isfinite(psi)) return std::numeric_limits<double>::infinity();
-    E += weight_[k] * psi;
+    const double w = weight_[k];
+    E += w * psi;
     if (grad)
-      for (int e = start_[k]; e < start_[k + 1]; ++e)
-        grad->segment<3>(z0 + 3 * handle_[e]) += weight_[k] * (P * d_[e]);
+      for (int e = start_[k]; e < start_[k + 1]; ++e) grad->segment<3>(z0 + 3 * handle_[e]) += w * (P * d_[e]);
     if (!hess) continue;
+    // c_k G_kᵀ H G_k with G_k(a + 3b, 3e + c) = δ_ac d_e[b], block by block:
+    //   T_e = Σ_b d_e[b] H(3b..3b+2, :)   (3x9),
+    //   block(e, f) = c_k Σ_b' T_e(:, 3b'..3b'+2) d_f[b'].
     const int m = start_[k + 1] - start_[k];
-    if (!project_psd_) {
-      // Exact Hessian c_k G_kᵀ H G_k (for derivative checks).
-      MatX G = MatX::Zero(9, 3 * m);
-      for (int e = 0; e < m; ++e)
-        for (int c = 0; c < 3; ++c)
-          for (int b = 0; b < 3; ++b) G(c + 3 * b, 3 * e + c) = d_[start_[k] + e][b];
-      const MatX Hk = weight_[k] * G.transpose() * H * G;
-      for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j)
-          hess->block<3, 3>(z0 + 3 * handle_[start_[k] + i], z0 + 3 * handle_[start_[k] + j]) += Hk.block<3, 3>(3 * i, 3 * j);
-      continue;
-    }
-    // Lᵀ: Cholesky when already positive definite (cheap), else eigenvalue clamping.
-    Mat9 Lt;
-    Eigen::LLT<Mat9> llt(H);
-    if (llt.info() == Eigen::Success) {
-      Lt = std::sqrt(weight_[k]) * llt.matrixU().toDenseMatrix();
-    } else {
-      Eigen::SelfAdjointEigenSolver<Mat9> eig(H);
-      const Vec9 root = (weight_[k] * eig.eigenvalues().cwiseMax(0.0)).cwiseSqrt();
-      Lt = root.asDiagonal() * eig.eigenvectors().transpose();
-    }
-    // G_k(a + 3b, 3h + c) = δ_ac d_h[b]  ⇒  (Lᵀ G_k)(i, 3e + c) = Σ_b Lᵀ(i, c + 3b) d_e[b].
-    Yk.resize(9, 3 * m);
+    T.resize(m);
     for (int e = 0; e < m; ++e) {
       const Vec3& d = d_[start_[k] + e];
-      for (int c = 0; c < 3; ++c) Yk.col(3 * e + c) = Lt.col(c) * d[0] + Lt.col(c + 3) * d[1] + Lt.col(c + 6) * d[2];
+      T[e] = w * (d[0] * H.middleRows<3>(0) + d[1] * H.middleRows<3>(3) + d[2] * H.middleRows<3>(6));
     }
-    if (dense) {
-      for (int e = 0; e < m; ++e) Y.block(9 * k, 3 * handle_[start_[k] + e], 9, 3) = Yk.middleCols(3 * e, 3);
-    } else {
-      YtY.resize(Yk.cols(), Yk.cols());
-      YtY.noalias() = Yk.transpose() * Yk;
-      for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j)
-          hess->block<3, 3>(z0 + 3 * handle_[start_[k] + i], z0 + 3 * handle_[start_[k] + j]) += YtY.block<3, 3>(3 * i, 3 * j);
+    for (int e = 0; e < m; ++e) {
+      const int row = z0 + 3 * handle_[start_[k] + e];
+      for (int f = e; f < m; ++f) {
+        const Vec3& d = d_[start_[k] + f];
+        const Mat3 block = d[0] * T[e].leftCols<3>() + d[1] * T[e].middleCols<3>(3) + d[2] * T[e].rightCols<3>();
+        const int col = z0 + 3 * handle_[start_[k] + f];
+        hess->block<3, 3>(row, col) += block;
+        if (f != e) hess->block<3, 3>(col, row) += block.transpose();
+      }
     }
-  }
-  if (hess && project_psd_ && dense) {
-    auto block = hess->block(z0, z0, r, r);
-    block.selfadjointView<Eigen::Lower>().rankUpdate(Y.transpose());
-    block.triangularView<Eigen::StrictlyUpper>() = block.transpose();
   }
   return E;
 }
