@@ -46,15 +46,17 @@ void run_bench(const BenchArgs& a) {
   const auto rows = run_benchmark(o);
   const std::string csv = (std::filesystem::path(a.out) / "bench.csv").string();
   const std::string svg = (std::filesystem::path(a.out) / "bench.svg").string();
+  const std::string md = (std::filesystem::path(a.out) / "bench.md").string();
   write_bench_csv(rows, csv);
+  write_bench_markdown(rows, md);
   write_bench_plot_svg(rows, svg, "sflsh bench: " + a.motion + (a.quick ? " (quick)" : ""));
-  std::printf("%-10s %4s %8s %6s %4s %9s %9s %8s %9s %9s %8s %6s\n", "method", "K", "dt", "iters", "def", "ms_med",
-              "ms_p95", "speedup", "err_mm", "max_mm", "rel_err", "peak");
+  std::printf("%-10s %-36s %4s %8s %6s %4s %9s %9s %8s %9s %9s %8s %6s\n", "method", "variant", "K", "dt", "iters",
+              "def", "ms_med", "ms_p95", "speedup", "err_mm", "max_mm", "rel_err", "peak");
   for (const auto& r : rows)
-    std::printf("%-10s %4d %8.5f %6d %4d %9.3f %9.3f %8.1f %9.3f %9.3f %8.3f %6.3f\n", r.method.c_str(), r.handles, r.dt,
-                r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm,
-                r.rel_err, r.peak_ratio);
-  std::printf("wrote %s and %s\n", csv.c_str(), svg.c_str());
+    std::printf("%-10s %-36s %4d %8.5f %6d %4d %9.3f %9.3f %8.1f %9.3f %9.3f %8.3f %6.3f\n", r.method.c_str(),
+                r.label.c_str(), r.handles, r.dt, r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95,
+                r.speedup, r.err_mean_mm, r.err_max_mm, r.rel_err, r.peak_ratio);
+  std::printf("wrote %s, %s and %s\n", csv.c_str(), md.c_str(), svg.c_str());
 }
 
 const CommandRegistrar reg(50, [](CLI::App& app) {
@@ -68,7 +70,7 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
   cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
-  cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.svg)")->capture_default_str();
+  cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.md, bench.svg)")->capture_default_str();
   cmd->callback([a] { run_bench(*a); });
 });
 

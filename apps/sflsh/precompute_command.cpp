@@ -20,6 +20,8 @@ struct PrecomputeArgs {
   std::string model = "procedural";
   std::string betas;
   int handles = 64;
+  int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
+  bool no_fit_cubature = false;
   std::string handles_file, thickness_map, out = "avatar.h5", batch, out_dir, cache_dir;
   bool no_cache = false;
   double cell_size = 0, facet_size = 0, facet_distance = 0;
@@ -52,6 +54,10 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
   PrecomputeOptions o;
   o.handles = a.handles;
   require(a.handles >= 1 && a.handles <= 2000, "--handles must be in [1, 2000], got ", a.handles);
+  require(a.elastic_samples_per_cell >= 1 && a.elastic_samples_per_cell <= 1000,
+          "--elastic-samples-per-cell must be in [1, 1000], got ", a.elastic_samples_per_cell);
+  o.elastic_samples_per_cell = a.elastic_samples_per_cell;
+  o.fit_elastic_cubature = !a.no_fit_cubature;
   if (!a.handles_file.empty()) o.handle_positions = read_handles_file(a.handles_file);
   if (!a.thickness_map.empty()) o.thickness = read_thickness_map(a.thickness_map);
   if (!a.no_cache) o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
@@ -108,6 +114,11 @@ const CommandRegistrar reg(20, [](CLI::App& app) {
   cmd->add_option("--model", a->model, "Body model: 'procedural' or an SMPL-format .h5/.npz file")->capture_default_str();
   cmd->add_option("--betas", a->betas, "Shape parameters b0,b1,... (missing entries are 0)");
   cmd->add_option("--handles", a->handles, "Number of control-point handles K (3K reduced DoFs)")->capture_default_str();
+  cmd->add_option("--elastic-samples-per-cell", a->elastic_samples_per_cell,
+                  "Elastic cubature candidates per cell of dominant weight")
+      ->capture_default_str();
+  cmd->add_flag("--no-fit-cubature", a->no_fit_cubature,
+                "Keep the stratified elastic cubature's volume weights (no stiffness fit)");
   cmd->add_option("--handles-file", a->handles_file, "Handle positions, one 'x y z' per line (metres, unposed)");
   cmd->add_option("--thickness-map", a->thickness_map, "Skin thickness scale per body region ('region scale' per line)");
   cmd->add_option("--out", a->out, "Output avatar file")->capture_default_str();

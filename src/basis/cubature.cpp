@@ -149,6 +149,29 @@ Cubature stratified_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<doub
   return out;
 }
 
+Cubature full_cubature(const TetMesh& mesh, const VecXi& node_role, bool simulated_only) {
+  std::vector<int> keep;
+  for (int t = 0; t < mesh.num_elements(); ++t) {
+    bool any_simulated = !simulated_only || node_role.size() == 0;
+    for (int c = 0; c < 4 && !any_simulated; ++c)
+      any_simulated = node_role[mesh.elements(t, c)] == int(NodeRole::Simulated);
+    if (any_simulated) keep.push_back(t);
+  }
+  Cubature cub;
+  cub.elements.resize(Eigen::Index(keep.size()));
+  cub.barycentric = MatXr::Constant(Eigen::Index(keep.size()), 4, 0.25);
+  cub.weights.resize(Eigen::Index(keep.size()));
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const int t = keep[i];
+    const Vec3 x0 = mesh.nodes.row(mesh.elements(t, 0)).transpose();
+    Mat3 D;
+    for (int c = 1; c < 4; ++c) D.col(c - 1) = mesh.nodes.row(mesh.elements(t, c)).transpose() - x0;
+    cub.elements[Eigen::Index(i)] = t;
+    cub.weights[Eigen::Index(i)] = std::abs(D.determinant()) / 6.0;
+  }
+  return cub;
+}
+
 Points cubature_points(const TetMesh& mesh, const Cubature& cubature) {
   Points p(cubature.size(), 3);
   for (int s = 0; s < cubature.size(); ++s) {

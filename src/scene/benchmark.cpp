@@ -13,6 +13,7 @@
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "sflsh/sim/full_fem.hpp"
+#include "sflsh/sim/posed_points.hpp"
 
 namespace sflsh {
 namespace {
@@ -89,27 +90,27 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion
   return tr;
 }
 
-/// Linear blend skinning of the surface with u = 0: the cost of "doing nothing".
+/// The surface posed by the skeleton alone (u = 0, pose blend shapes and
+/// linear blend skinning, as the simulator poses it): the cost of "doing nothing".
 Trace run_skinning(const Avatar& a, const MotionClip& motion, double seconds, double h) {
   Trace tr;
   const long steps = std::lround(seconds / h);
   const int per = steps_per_frame(h);
   const Points zero = Points::Zero(a.surface_rest.rows(), 3);
   tr.u.push_back(zero);
-  Points x(a.surface_rest.rows(), 3);
+  const PosedPoints surface = PosedPoints::at_surface(a);
+  Configuration q;
+  q.z = VecX::Zero(a.num_reduced());
+  double checksum = 0;  // keeps the posing from being optimized away
   for (long s = 1; s <= steps; ++s) {
     Timer t;
-    const auto G = target_bones(a, motion.sample(s * h));
-    for (Eigen::Index v = 0; v < a.surface_rest.rows(); ++v) {
-      Vec3 p = Vec3::Zero();
-      const Vec3 xr = a.surface_rest.row(v);
-      for (int j = 0; j < 24; ++j)
-        if (const double w = a.surface_weights(v, j); w != 0.0) p += w * (G[j] * xr);
-      x.row(v) = p;
-    }
+    q.bones = target_bones(a, motion.sample(s * h));
+    const Points offsets = surface_pose_offsets(a, q.bones);
+    checksum += surface.world(q, &offsets)(0, 0);
     tr.ms.push_back(t.ms());
     if (s % per == 0) tr.u.push_back(zero);
   }
+  require(std::isfinite(checksum), "bench: skinning produced non-finite positions");
   return tr;
 }
 
@@ -159,17 +160,20 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   if (o.handle_counts.empty()) o.handle_counts = o.quick ? std::vector<int>{16, 64} : std::vector<int>{16, 32, 64, 128};
   if (std::find(o.handle_counts.begin(), o.handle_counts.end(), o.default_handles) == o.handle_counts.end())
     o.handle_counts.push_back(o.default_handles);
+  std::sort(o.handle_counts.begin(), o.handle_counts.end());
 
   const BodyModel model = load_body_model(o.model);
   const TemplateVolume tv = cached_template_volume(model, o.precompute);
   std::vector<std::shared_ptr<const Avatar>> avatars;
+  std::shared_ptr<const Avatar> default_avatar;
   for (int K : o.handle_counts) {
     PrecomputeOptions po = o.precompute;
     po.handles = K;
     log_info("bench: shape stage with K = " + std::to_string(K) + " handles");
     avatars.push_back(std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po)));
+    if (K == o.default_handles) default_avatar = avatars.back();
   }
-  const Avatar& base = *avatars.front();
+  const Avatar& base = *default_avatar;
   MotionOptions mo;
   mo.rest_joints = base.joints_rest;
   mo.builtin_seconds = o.seconds + 0.5;
@@ -177,35 +181,61 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   const std::vector<int> region = simulated_region(base);
 
   const double h = o.default_dt;
-  const Trace ref = run_reference(avatars.front(), motion, o.seconds, h);
+  const Trace ref = run_reference(default_avatar, motion, o.seconds, h);
   std::vector<BenchRow> rows;
-  BenchRow rr{"reference", 0, h, -1, false};
+  BenchRow rr{"reference", "full FEM, Newton to convergence", 0, h, -1, false};
   compare(ref, ref, region, rr);
   rows.push_back(rr);
   const double ref_ms = rr.ms_median;
 
-  auto add = [&](const Trace& tr, const std::string& method, int K, double dt, int iters, bool is_default) {
-    BenchRow r{method, K, dt, iters, is_default};
+  auto add = [&](const Trace& tr, const std::string& method, const std::string& label, int K, double dt, int iters,
+                 bool is_default) {
+    BenchRow r{method, label, K, dt, iters, is_default};
     compare(tr, ref, region, r);
     r.speedup = r.ms_median > 0 ? ref_ms / r.ms_median : 0;
     rows.push_back(r);
   };
-  for (size_t i = 0; i < avatars.size(); ++i) {
-    const int K = o.handle_counts[i];
-    const bool is_def_K = K == o.default_handles;
-    add(run_reduced(avatars[i], motion, o.seconds, h, 1, "reduced K=" + std::to_string(K)), "reduced", K, h, 1,
-        is_def_K);
-    if (!is_def_K) continue;
-    // Time steps and Newton iterations around the default.
-    std::vector<double> dts = o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0};
-    for (double dt : dts)
-      add(run_reduced(avatars[i], motion, o.seconds, dt, 1, "reduced K=" + std::to_string(K) + " dt=" + std::to_string(dt)),
-          "reduced", K, dt, 1, false);
-    add(run_reduced(avatars[i], motion, o.seconds, h, o.converged_newton_iters,
-                    "reduced K=" + std::to_string(K) + " converged"),
-        "reduced", K, h, o.converged_newton_iters, false);
+  auto reduced = [&](std::shared_ptr<const Avatar> a, int K, double dt, int iters, const std::string& what,
+                     bool is_default) {
+    const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
+    add(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label), "reduced", label, K, dt, iters, is_default);
+  };
+  const int K = o.default_handles;
+  // Handle counts at the default time step and cubature, one Newton step.
+  for (size_t i = 0; i < avatars.size(); ++i)
+    reduced(avatars[i], o.handle_counts[i], h, 1, o.handle_counts[i] == K ? "default" : "", o.handle_counts[i] == K);
+  // Time steps and Newton iterations around the default.
+  for (double dt : o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0})
+    reduced(default_avatar, K, dt, 1, "dt=1/" + std::to_string(int(std::lround(1.0 / dt))), false);
+  reduced(default_avatar, K, h, o.converged_newton_iters, "Newton converged", false);
+  // Cubature variants: the stratified samples without the stiffness fit, more
+  // or fewer candidates, and exact integration (one sample per tet) for the
+  // elastic energy alone and for elasticity and inertia: the error of the basis itself.
+  auto cubature_variant = [&](int per_cell, bool fit, const std::string& what) {
+    PrecomputeOptions po = o.precompute;
+    po.handles = K;
+    po.elastic_samples_per_cell = per_cell;
+    po.fit_elastic_cubature = fit;
+    log_info("bench: shape stage for " + what);
+    const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
+    reduced(a, K, h, 1, what + " (" + std::to_string(a->elastic.size()) + " samples)", false);
+  };
+  const PrecomputeOptions defaults = o.precompute;
+  cubature_variant(defaults.elastic_samples_per_cell, !defaults.fit_elastic_cubature,
+                   std::string(defaults.fit_elastic_cubature ? "no" : "with") + " stiffness fit");
+  if (!o.quick) {
+    cubature_variant(1, true, "1 sample/cell, fitted");
+    cubature_variant(6, true, "6 samples/cell, fitted");
   }
-  add(run_skinning(base, motion, o.seconds, h), "skinning", 0, h, 0, false);
+  auto exact = std::make_shared<Avatar>(base);
+  exact->elastic = basis::full_cubature(exact->tet, exact->node_role, true);
+  reduced(exact, K, h, 1, "elastic on all tets", false);
+  if (!o.quick) {
+    auto exact_both = std::make_shared<Avatar>(*exact);
+    exact_both->inertia = basis::full_cubature(exact->tet);
+    reduced(exact_both, K, h, 1, "elastic + inertia on all tets", false);
+  }
+  add(run_skinning(base, motion, o.seconds, h), "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }
 
@@ -227,10 +257,28 @@ void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path)
   std::rename(tmp.c_str(), path.c_str());
 }
 
+void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& path) {
+  std::ofstream f(path + ".partial");
+  if (!f) fail(path, ": cannot write");
+  f << "| method | variant | K | dt (s) | Newton iters | ms/step median | p95 | speedup | err mean (mm) | err max (mm) "
+       "| rel_err | peak ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char buf[512];
+  for (const auto& r : rows) {
+    std::snprintf(buf, sizeof buf, "| %s | %s | %d | 1/%.0f | %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3f | %.3f |\n",
+                  r.method.c_str(), r.label.c_str(), r.handles, 1.0 / r.dt,
+                  r.newton_iters < 0 ? "to convergence" : std::to_string(r.newton_iters).c_str(), r.ms_median,
+                  r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm, r.rel_err, r.peak_ratio);
+    f << (r.is_default ? std::string(buf).replace(2, r.method.size(), "**" + r.method + "**") : std::string(buf));
+  }
+  if (!f) fail(path, ": write failed");
+  f.close();
+  std::rename((path + ".partial").c_str(), path.c_str());
+}
+
 void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& path, const std::string& title) {
   // Log-log axes: x = ms per step, y = relative error (the reference sits at 0
   // error, so it is drawn as a vertical line at its step time).
-  const double W = 720, H = 480, L = 80, R = 200, T = 50, B = 60;
+  const double W = 900, H = 480, L = 80, R = 300, T = 50, B = 60;
   double xmin = 1e9, xmax = 0, ymin = 1e9, ymax = 0;
   for (const auto& r : rows) {
     xmin = std::min(xmin, std::max(r.ms_median, 1e-3));
@@ -273,15 +321,17 @@ void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& 
       f << "<line x1='" << X(r.ms_median) << "' y1='" << T << "' x2='" << X(r.ms_median) << "' y2='" << H - B
         << "' stroke='" << color << "' stroke-dasharray='6,4'/>\n";
     } else {
-      if (r.method == "skinning") {
-        label = "skinning only";
+      label = r.label;
+      if (r.method == "skinning")
         color = "#d62728";
-      } else {
-        std::snprintf(buf, sizeof buf, "K=%d dt=1/%.0f %s%s", r.handles, 1.0 / r.dt,
-                      r.newton_iters > 1 ? "converged" : "1 Newton", r.is_default ? " (default)" : "");
-        label = buf;
-        color = r.newton_iters > 1 ? "#2ca02c" : r.dt != rows[0].dt ? "#ff7f0e" : "#1f77b4";
-      }
+      else if (r.newton_iters > 1)
+        color = "#2ca02c";
+      else if (r.dt != rows[0].dt)
+        color = "#ff7f0e";
+      else if (r.label.find("tets") != std::string::npos || r.label.find("cell") != std::string::npos)
+        color = "#9467bd";
+      else
+        color = "#1f77b4";
       f << "<circle cx='" << X(r.ms_median) << "' cy='" << Y(r.rel_err) << "' r='" << (r.is_default ? 7 : 5)
         << "' fill='" << color << "' stroke='black'/>\n";
     }

@@ -109,6 +109,12 @@ MaterialPoint::MaterialPoint(const RegionMaterial& m, const Mat3& frame) {
   kappa = Ebar / (3.0 * (1.0 - 2.0 * m.poisson));
 }
 
+Mat9 linearized_hessian(const MaterialPoint& material) {
+  Mat9 H;
+  strain_energy_density(Mat3::Identity(), material, nullptr, &H, false);
+  return H;
+}
+
 double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMaterial& material, Mat3* dPsi_dF,
                              Mat9* d2Psi_dF2, bool project_psd) {
   return strain_energy_density(F, MaterialPoint(material, frame), dPsi_dF, d2Psi_dF2, project_psd);
@@ -138,7 +144,8 @@ double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3*
     dex = e0 * (1 + d);
     ddex = e0;
   }
-  const double psi_fung = 0.5 * c * (ex - 1.0);
+  // expm1: at small strain x ~ 1e-6, exp(x) − 1 would keep only ~10 digits.
+  const double psi_fung = 0.5 * c * (x <= kFungExponentMax ? std::expm1(x) : ex - 1.0);
   const double dphi = dex;             // dφ/dΨ_s
   const double ddphi = 2.0 * ddex / c; // d²φ/dΨ_s²
 

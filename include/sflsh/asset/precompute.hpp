@@ -10,6 +10,7 @@
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/cubature.hpp"
 #include "sflsh/basis/handle_placement.hpp"
+#include "sflsh/basis/stiffness_fitted_cubature.hpp"
 #include "sflsh/body/body_model.hpp"
 #include "sflsh/volume/shape_volume.hpp"
 #include "sflsh/volume/template_volume.hpp"
@@ -30,6 +31,9 @@ struct PrecomputeOptions {
   /// Elastic cubature: samples per stratified cell (basis::stratified_cubature);
   /// 0 = use the data-oblivious inertia samples for elasticity too.
   int elastic_samples_per_cell = 3;
+  /// Refit the stratified samples' weights to the basis' stiffness tensor
+  /// (basis::stiffness_fitted_cubature); samples whose weight goes to 0 are dropped.
+  bool fit_elastic_cubature = true;
   /// Folder of the template-stage cache ("" = no cache).
   std::string cache_dir;
 };
@@ -41,6 +45,7 @@ struct PrecomputeReport {
   ShapeReport shape_report;
   basis::BbwReport bbw_report;
   basis::CubatureErrors elastic_errors, inertia_errors;
+  basis::FittedCubatureReport elastic_fit;  ///< valid when options.fit_elastic_cubature
   double template_s = 0, shape_geometry_s = 0, handles_s = 0, weights_s = 0, cubature_s = 0;
   double shape_stage_s = 0;  ///< everything per β
   double peak_rss_mib = 0;

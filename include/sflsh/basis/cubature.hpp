@@ -46,6 +46,12 @@ Points cubature_points(const TetMesh& mesh, const Cubature& cubature);
 Cubature stratified_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
                              const VecXi& dominant_bone, int samples_per_cell = 3);
 
+/// Full integration: one sample per tet at its centroid, weight its volume.
+/// Exact for the elastic energy (F is constant per tet); the benchmark's
+/// error floor of the basis alone. Tets whose nodes are all Dirichlet
+/// (`node_role` != Simulated; empty = keep all) are skipped when `simulated_only`.
+Cubature full_cubature(const TetMesh& mesh, const VecXi& node_role = VecXi(), bool simulated_only = false);
+
 /// Cubature against full integration over all tets (relative errors are
 /// (cubature − full) / full).
 struct CubatureErrors {

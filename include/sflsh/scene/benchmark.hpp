@@ -18,7 +18,7 @@
 namespace sflsh {
 
 struct BenchOptions {
-  bool quick = false;                     ///< small set of variants, 0.5 s of motion
+  bool quick = false;                     ///< fewer variants, 0.5 s of motion
   std::string motion = "builtin:jump";
   double seconds = 0;                     ///< 0: 0.5 s quick, 2 s full
   std::string model = "procedural";
@@ -32,6 +32,7 @@ struct BenchOptions {
 
 struct BenchRow {
   std::string method;  ///< reference | reduced | skinning
+  std::string label;   ///< the variant in words (table, plot legend; not in the CSV)
   int handles = 0;
   double dt = 0;
   int newton_iters = 0;
@@ -46,6 +47,8 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& options);
 /// CSV with the header
 /// method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio
 void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path);
+/// The rows as a Markdown table (with labels), for the README.
+void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& path);
 /// Log-log scatter of rel_err against ms per step, as SVG.
 void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& path, const std::string& title);
 

@@ -44,6 +44,10 @@ struct MaterialPoint {
 /// tension. This costs a 3x3 eigensolve instead of a 9x9 one.
 double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3* dPsi_dF = nullptr,
                              Mat9* d2Psi_dF2 = nullptr, bool project_psd = false);
+/// ∂²Ψ/∂F² at F = I (9x9, constant): the Hessian of the linearized energy
+/// Ψ₂(F) = ½ vec(F − I)ᵀ H₂ vec(F − I) (small-strain orthotropic elasticity;
+/// Fung saturation and the barrier have no second-order term at F = I).
+Mat9 linearized_hessian(const MaterialPoint& material);
 /// The same for a material and frame given separately (builds the MaterialPoint).
 double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMaterial& material,
                              Mat3* dPsi_dF = nullptr, Mat9* d2Psi_dF2 = nullptr, bool project_psd = false);
