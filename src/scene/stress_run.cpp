@@ -1,0 +1,150 @@
+#include "sflsh/scene/stress_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/motion/load_motion.hpp"
+
+namespace sflsh {
+
+std::string StressReport::describe() const {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(3);
+  o << "stress: " << steps << " steps (" << accepted << " accepted, " << damped << " damped, " << rejected
+    << " rejected)\n"
+    << "  finite state:            " << (finite ? "yes" : "NO") << "\n"
+    << "  min det F over samples:  " << min_det << (no_inversion ? "" : "  (INVERTED)") << "\n"
+    << "  peak soft displacement:  first 10 % " << peak_soft_mm_early << " mm, last window " << peak_soft_mm_late
+    << " mm" << (stable ? "" : "  (GROWING)") << "\n"
+    << "  result: " << (passed() ? "PASSED" : "FAILED") << "\n";
+  return o.str();
+}
+
+StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOptions& o) {
+  require(o.steps >= 1, "stress: steps must be >= 1, got ", o.steps);
+  require(o.window >= 1, "stress: window must be >= 1, got ", o.window);
+  MotionOptions mo;
+  mo.rest_joints = avatar->joints_rest;
+  mo.builtin_seconds = double(o.steps) * o.dt + 1.0;  // built-ins cover the whole run
+  const MotionClip motion = load_motion(o.motion, mo);
+
+  RunOptions ro;
+  ro.sim.h = o.dt;
+  ro.sim.bones_dynamic = true;
+  ro.seconds = double(o.steps) * o.dt;
+  ro.output_fps = 1;  // frames are not kept; the callback records everything
+  ro.keep_frames = false;
+
+  StressReport r;
+  r.min_det = std::numeric_limits<double>::infinity();
+  StressWindow w;
+  std::vector<double> ms;
+  w.min_det = std::numeric_limits<double>::infinity();
+  long step = 0;
+  ro.on_step = [&](const Simulator& sim, const StepReport& rep) {
+    ++step;
+    const double det = sim.elastic().min_det(sim.state().z);
+    const double peak = 1e3 * sim.soft_displacement().rowwise().norm().maxCoeff();
+    double elastic = 0;
+    for (const TermEnergy& e : rep.energies)
+      if (e.name == "elastic") elastic = e.value;
+    w.min_det = std::min(w.min_det, det);
+    w.peak_soft_mm = std::max(w.peak_soft_mm, peak);
+    w.max_elastic_J = std::max(w.max_elastic_J, elastic);
+    w.damped += rep.damped;
+    w.rejected += rep.rejected;
+    ms.push_back(rep.ms_total);
+    r.accepted += rep.accepted;
+    r.damped += rep.damped;
+    r.rejected += rep.rejected;
+    if (step % o.window == 0 || step == o.steps) {
+      w.t_end = double(step) * o.dt;
+      std::nth_element(ms.begin(), ms.begin() + long(ms.size() / 2), ms.end());
+      w.ms_median = ms[ms.size() / 2];
+      r.windows.push_back(w);
+      w = StressWindow();
+      w.min_det = std::numeric_limits<double>::infinity();
+      ms.clear();
+    }
+  };
+  try {
+    run_simulation(avatar, motion, ro);
+  } catch (const Error& e) {
+    r.finite = false;
+    std::fprintf(stderr, "stress: %s\n", e.what());
+  }
+  r.steps = step;
+  for (const StressWindow& x : r.windows) r.min_det = std::min(r.min_det, x.min_det);
+  const size_t early = std::max<size_t>(1, r.windows.size() / 10);
+  for (size_t i = 0; i < std::min(early, r.windows.size()); ++i)
+    r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
+  if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;
+  r.no_inversion = r.min_det > 0;
+  r.stable = r.finite && r.steps == o.steps && r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
+  return r;
+}
+
+void write_stress_csv(const StressReport& r, const std::string& path) {
+  std::ofstream f(path + ".partial");
+  if (!f) fail(path, ": cannot write");
+  f << "t_end,peak_soft_mm,max_elastic_J,min_det,damped,rejected,ms_median\n";
+  for (const StressWindow& w : r.windows)
+    f << w.t_end << ',' << w.peak_soft_mm << ',' << w.max_elastic_J << ',' << w.min_det << ',' << w.damped << ','
+      << w.rejected << ',' << w.ms_median << '\n';
+  if (!f) fail(path, ": write failed");
+  f.close();
+  std::rename((path + ".partial").c_str(), path.c_str());
+}
+
+void write_stress_plot_svg(const StressReport& r, const std::string& path, const std::string& title) {
+  // Three stacked panels sharing the time axis, each scaled to its own range.
+  const double W = 900, panel = 150, L = 90, R = 30, T = 40, gap = 30;
+  const double H = T + 3 * panel + 2 * gap + 50;
+  const double t1 = r.windows.empty() ? 1.0 : r.windows.back().t_end;
+  std::ofstream f(path + ".partial");
+  if (!f) fail(path, ": cannot write");
+  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
+    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n"
+    << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
+  struct Series {
+    const char* name;
+    double StressWindow::*field;
+    const char* color;
+  };
+  const Series series[3] = {{"peak soft displacement (mm)", &StressWindow::peak_soft_mm, "#1f77b4"},
+                            {"max elastic energy (J)", &StressWindow::max_elastic_J, "#ff7f0e"},
+                            {"min det F over cubature samples", &StressWindow::min_det, "#2ca02c"}};
+  for (int p = 0; p < 3; ++p) {
+    const double y0 = T + p * (panel + gap);
+    double lo = 0, hi = 0;
+    for (const StressWindow& w : r.windows) hi = std::max(hi, w.*(series[p].field));
+    if (p == 2) {
+      lo = hi;
+      for (const StressWindow& w : r.windows) lo = std::min(lo, w.*(series[p].field));
+      lo = std::min(lo, 0.0);
+      hi = std::max(hi, 1.0);
+    }
+    if (hi <= lo) hi = lo + 1;
+    auto X = [&](double t) { return L + t / t1 * (W - L - R); };
+    auto Y = [&](double v) { return y0 + panel - (v - lo) / (hi - lo) * panel; };
+    f << "<rect x='" << L << "' y='" << y0 << "' width='" << W - L - R << "' height='" << panel
+      << "' fill='none' stroke='black'/>\n<text x='" << L + 6 << "' y='" << y0 + 14 << "'>" << series[p].name
+      << "</text>\n<text x='" << L - 6 << "' y='" << y0 + 12 << "' text-anchor='end'>" << hi << "</text>\n<text x='"
+      << L - 6 << "' y='" << y0 + panel << "' text-anchor='end'>" << lo << "</text>\n<polyline fill='none' stroke='"
+      << series[p].color << "' stroke-width='1.5' points='";
+    for (const StressWindow& w : r.windows) f << X(w.t_end) << ',' << Y(w.*(series[p].field)) << ' ';
+    f << "'/>\n";
+  }
+  f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 12 << "' text-anchor='middle'>simulated time (s), 0 to " << t1
+    << "</text>\n</svg>\n";
+  f.close();
+  std::rename((path + ".partial").c_str(), path.c_str());
+}
+
+}  // namespace sflsh
