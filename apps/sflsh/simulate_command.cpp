@@ -1,12 +1,17 @@
 // `sflsh simulate`: drive an avatar with a motion, write the result cache,
 // optional exports and a picture.
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/asset/precompute.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/time_step.hpp"
+#include "sflsh/io/atomic_output.hpp"
 #include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/file_betas_avatar.hpp"
 #include "sflsh/scene/material_file.hpp"
 #include "sflsh/scene/result_export.hpp"
 #include "sflsh/scene/simulation_run.hpp"
@@ -16,34 +21,13 @@ namespace {
 
 struct SimulateArgs {
   std::string avatar, motion = "builtin:jump", out = "result.h5", exp, render, material, dt = "1/60", bones = "dynamic";
-  std::string units = "auto", joint_map;
+  std::string units = "auto", joint_map, cache_dir;
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
+  double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
-  bool line_search = false;
+  bool line_search = false, use_file_betas = false, start_at_rest = false;
 };
 
-/// "1/60", "0.0166" → seconds.
-double parse_time_step(const std::string& s) {
-  double v = 0;
-  const auto slash = s.find('/');
-  try {
-    size_t used = 0;
-    if (slash == std::string::npos) {
-      v = std::stod(s, &used);
-      if (used != s.size()) throw std::invalid_argument(s);
-    } else {
-      size_t u1 = 0, u2 = 0;
-      const std::string a = s.substr(0, slash), b = s.substr(slash + 1);
-      const double num = std::stod(a, &u1), den = std::stod(b, &u2);
-      if (u1 != a.size() || u2 != b.size() || den == 0) throw std::invalid_argument(s);
-      v = num / den;
-    }
-  } catch (const std::exception&) {
-    fail("--dt: '", s, "' is not a time step (seconds, e.g. 0.0166 or 1/60)");
-  }
-  require(v > 0 && v <= 0.1, "--dt must be in (0, 0.1] s, got ", v);
-  return v;
-}
 
 void run_simulate(const SimulateArgs& a) {
   RunOptions o;
@@ -53,10 +37,13 @@ void run_simulate(const SimulateArgs& a) {
   require(a.newton_iters >= 1 && a.newton_iters <= 100, "--newton-iters must be in [1, 100], got ", a.newton_iters);
   o.sim.newton.iterations = a.newton_iters;
   o.sim.newton.line_search = a.line_search;
+  require(std::isfinite(a.max_rotation_step), "--max-rotation-step must be finite");
+  o.sim.newton.max_rotation_step = a.max_rotation_step;
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
   o.seconds = a.seconds;
   o.output_fps = a.output_fps;
+  o.start_at_rest = a.start_at_rest;
   // Check every output can be written before spending time simulating.
   for (const std::string& p : {a.out, a.render}) {
     if (p.empty()) continue;
@@ -65,8 +52,13 @@ void run_simulate(const SimulateArgs& a) {
             " does not exist");
   }
 
+  if (a.use_file_betas)
+    require(a.motion.rfind("builtin:", 0) != 0 && io::lower_extension(a.motion) == ".npz",
+            "--use-file-betas needs an AMASS .npz motion (it builds the avatar for the file's 'betas'), got --motion '",
+            a.motion, "'");
+
   auto avatar = std::make_shared<Avatar>(read_avatar(a.avatar));
-  if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
+  std::string avatar_name = a.avatar;
 
   MotionOptions mo;
   mo.start = a.start;
@@ -77,14 +69,26 @@ void run_simulate(const SimulateArgs& a) {
   mo.rest_joints = avatar->joints_rest;
   mo.builtin_seconds = a.seconds > 0 ? a.seconds : 5.0;
   MotionReport mrep;
-  const MotionClip motion = load_motion(a.motion, mo, &mrep);
+  MotionClip motion = load_motion(a.motion, mo, &mrep);
+  if (a.use_file_betas) {
+    require(mrep.betas.size() > 0, a.motion, ": --use-file-betas: the file has no 'betas' key (the subject's shape)");
+    FileBetasReport brep;
+    const std::string cache = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
+    avatar = std::make_shared<Avatar>(avatar_for_file_betas(*avatar, a.avatar, mrep.betas, cache, &brep));
+    std::cout << brep.describe();
+    avatar_name = brep.avatar_path;
+    // The AMASS axis change uses the avatar's rest pelvis: read again for the shaped skeleton.
+    mo.rest_joints = avatar->joints_rest;
+    motion = load_motion(a.motion, mo, &mrep);
+  }
+  if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
   std::cerr << mrep.describe();
 
   // Frames stream into the result file; exports and the picture read it back.
   o.keep_frames = false;
   ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
   SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
-  r.avatar = a.avatar;
+  r.avatar = avatar_name;
   writer.finish(r);
   std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
   if (!a.exp.empty() || !a.render.empty()) {
@@ -107,8 +111,14 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
   cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
   cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
+  cmd->add_option("--max-rotation-step", a->max_rotation_step,
+                  "Largest bone rotation per Newton iteration (rad); larger steps are scaled down as a whole "
+                  "(counted as damped); <= 0: no cap")
+      ->capture_default_str();
   cmd->add_option("--bones", a->bones, "'dynamic' (bones are DoFs tracking the motion) or 'kinematic' (prescribed)")
       ->capture_default_str();
+  cmd->add_flag("--start-at-rest", a->start_at_rest,
+                "Start at rest in the motion's first pose (default: moving with the motion's initial velocity)");
   cmd->add_option("--damping", a->damping, "Stiffness-proportional damping of the soft tissue (s)")->capture_default_str();
   cmd->add_option("--material", a->material, "YAML file overriding material parameters per region");
   cmd->add_option("--output-fps", a->output_fps, "Frames written per simulated second")->capture_default_str();
@@ -117,6 +127,11 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--speed", a->speed, "Motion playback speed factor")->capture_default_str();
   cmd->add_option("--units", a->units, "BVH length unit: cm|m|inch|auto")->capture_default_str();
   cmd->add_option("--joint-map", a->joint_map, "Joint-name map file for BVH/FBX skeletons ('source smpl' per line)");
+  cmd->add_flag("--use-file-betas", a->use_file_betas,
+                "AMASS .npz motions: simulate an avatar of the file's 'betas' (same body model and handle count as "
+                "--avatar; built once, then reused from --cache-dir)");
+  cmd->add_option("--cache-dir", a->cache_dir,
+                  "Cache of template stages and --use-file-betas avatars (default: $SFLSH_CACHE_DIR or ~/.cache/sflsh)");
   cmd->add_option("--out", a->out, "Result file (HDF5)")->capture_default_str();
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");

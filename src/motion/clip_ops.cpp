@@ -23,6 +23,25 @@ Vec3 axis_angle_from_quaternion(const Eigen::Quaterniond& q_in) {
   return q.vec() * (angle / s);
 }
 
+FirstFrameJump first_frame_jump(const MotionClip& clip) {
+  FirstFrameJump out;
+  // Largest local rotation (rad) of any joint between frames f and f + 1.
+  auto largest_turn = [&](int f, int* joint) {
+    double best = -1;
+    for (int j = 0; j < int(clip.rotations[f].size()) && j < int(clip.rotations[f + 1].size()); ++j) {
+      const double a = clip.rotations[f][j].angularDistance(clip.rotations[f + 1][j]);
+      if (a > best) best = a, *joint = j;
+    }
+    return std::max(best, 0.0);
+  };
+  if (clip.num_frames() < 2) return out;
+  out.angle = largest_turn(0, &out.joint);
+  int unused = -1;
+  for (int f = 1; f + 1 < clip.num_frames(); ++f) out.later_max = std::max(out.later_max, largest_turn(f, &unused));
+  out.discontinuous = clip.num_frames() >= 3 && out.angle > 0.5 && out.angle > 2.5 * out.later_max;
+  return out;
+}
+
 void validate_clip(const MotionClip& clip) {
   require(clip.fps > 0 && std::isfinite(clip.fps), clip.name, ": frame rate must be positive, got ", clip.fps);
   require(clip.num_frames() > 0, clip.name, ": motion has no frames");

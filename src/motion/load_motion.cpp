@@ -99,6 +99,21 @@ MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionRe
   clip.name = spec;
   r.source_frames = clip.num_frames();
   r.source_fps = clip.fps;
+  if (o.drop_first_frame_jump && (r.format == "bvh" || r.format == "assimp")) {
+    const FirstFrameJump jump = first_frame_jump(clip);
+    if (jump.discontinuous) {
+      clip.rotations.erase(clip.rotations.begin());
+      clip.translations.erase(clip.translations.begin());
+      if (o.root_from_start) {  // still relative to the (new) first frame
+        const Vec3 t0 = clip.translations[0];
+        for (auto& t : clip.translations) t -= t0;
+      }
+      r.dropped_first_frame = true;
+      r.first_frame_jump = jump.angle;
+      r.later_max_jump = jump.later_max;
+      r.first_frame_jump_joint = kSmplJointNames[jump.joint];
+    }
+  }
   if (o.start > 0 || o.end >= 0) clip = trim(clip, o.start, o.end);
   if (o.speed != 1) clip = change_speed(clip, o.speed);
   if (o.fps > 0 && std::abs(o.fps - clip.fps) > 1e-9 * o.fps) clip = resample(clip, o.fps);
@@ -114,6 +129,11 @@ std::string MotionReport::describe() const {
   os << std::setprecision(6);
   os << "motion: " << source << " (" << format << ")\n";
   os << "  source: " << source_frames << " frames at " << source_fps << " fps\n";
+  if (dropped_first_frame)
+    os << std::setprecision(3) << "  dropped the file's first frame: the body jumps " << first_frame_jump << " rad ("
+       << first_frame_jump_joint << ") from it into the next frame, later frames change by at most " << later_max_jump
+       << " rad (an added T-pose?)\n"
+       << std::setprecision(6);
   os << "  clip:   " << frames << " frames at " << fps << " fps, " << duration << " s\n";
   if (!source_joints.empty()) {
     os << "  file joints (" << source_joints.size() << "): " << join(source_joints) << "\n";
@@ -141,7 +161,8 @@ std::string MotionReport::to_json() const {
      << ", \"joint_map\": " << json_string(joint_map) << ", \"units\": " << json_string(units)
      << ", \"metres_per_unit\": " << metres_per_unit << ", \"avatar_scale\": " << avatar_scale
      << ", \"mapped\": " << json_list(mapped) << ", \"ignored\": " << json_list(ignored)
-     << ", \"undriven\": " << json_list(undriven) << ", \"betas\": [";
+     << ", \"undriven\": " << json_list(undriven)
+     << ", \"dropped_first_frame\": " << (dropped_first_frame ? "true" : "false") << ", \"betas\": [";
   for (Eigen::Index i = 0; i < betas.size(); ++i) os << (i ? ", " : "") << betas[i];
   os << "], \"gender\": " << json_string(gender) << "}";
   return os.str();

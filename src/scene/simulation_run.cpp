@@ -38,6 +38,12 @@ std::vector<Points> unstack(const std::vector<double>& flat, const std::vector<s
   return out;
 }
 
+// World position of SMPL joint 0 (the pelvis) under bone transforms `bones`:
+// G_0 J̄_0, as joint_world_positions() and the result's /frames/joints put it.
+Vec3 pelvis_position(const Avatar& avatar, const std::vector<Isometry>& bones) {
+  return bones[0] * Vec3(avatar.joints_rest.row(0).transpose());
+}
+
 }  // namespace
 
 double SimulationResult::median_step_ms() const { return percentile(step_ms, 0.5); }
@@ -57,6 +63,9 @@ std::string SimulationResult::describe() const {
       o << (i ? ", " : " ") << part_names[i] << " " << part_ms[i] / double(step_ms.size());
     o << "\n";
   }
+  if (pelvis_frames > 0)
+    o << std::setprecision(1) << "pelvis vs motion root: mean " << pelvis_error_mean * 1e3 << " mm, max "
+      << pelvis_error_max * 1e3 << " mm over " << pelvis_frames << " frames\n";
   return o.str();
 }
 
@@ -80,7 +89,22 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     add_skeleton_terms(terms, *avatar, options.skeleton);
     for (auto& t : terms) sim.add_term(std::move(t));
   }
-  sim.reset(target_bones(*avatar, motion.sample(0.0)));
+  std::vector<Isometry> targets = target_bones(*avatar, motion.sample(0.0));
+  if (options.start_at_rest) {
+    sim.reset(targets);
+  } else {
+    // Start moving with the motion: q_{-1} = Δ⁻¹ q_0 with Δ = G(h) G(0)⁻¹ the
+    // first step's motion of each bone, so (q_0 − q_{-1})/h is the motion's
+    // velocity. Mocap clips start mid-motion (a run at 3-4 m/s); from rest
+    // the tracking springs needed ~0.3 s and up to 4 cm to catch up.
+    const std::vector<Isometry> next = target_bones(*avatar, motion.sample(h));
+    Configuration q0, q_prev;
+    q0.bones = targets;
+    q0.z = VecX::Zero(avatar->num_reduced());
+    q_prev.z = q0.z;
+    for (size_t j = 0; j < targets.size(); ++j) q_prev.bones.push_back(targets[j] * next[j].inverse() * targets[j]);
+    sim.reset(q0, q_prev);
+  }
 
   SimulationResult r;
   r.motion = motion.name;
@@ -89,8 +113,16 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
   r.newton_iters = options.sim.newton.iterations;
   r.faces = avatar->surface_faces;
   r.surface_rest = avatar->surface_rest;
+  double pelvis_error_sum = 0;
+  // `targets` holds the target bones at time t.
   auto record_frame = [&](double t, double ms) {
-    FrameData fr{t, ms, sim.posed_surface(), sim.soft_displacement(), sim.joints(), sim.state().z};
+    FrameData fr{t, ms, sim.posed_surface(), sim.soft_displacement(), sim.joints(), sim.state().z,
+                 pelvis_position(*avatar, targets)};
+    const double pelvis_error = (fr.joints.row(0).transpose() - fr.target_pelvis).norm();
+    pelvis_error_sum += pelvis_error;
+    r.pelvis_error_max = std::max(r.pelvis_error_max, pelvis_error);
+    ++r.pelvis_frames;
+    r.pelvis_error_mean = pelvis_error_sum / r.pelvis_frames;
     ++r.num_frames;
     if (on_frame) on_frame(fr);
     if (!options.keep_frames) return;
@@ -100,6 +132,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     r.frame_displacement.push_back(std::move(fr.displacement));
     r.frame_joints.push_back(std::move(fr.joints));
     r.frame_reduced.push_back(std::move(fr.reduced));
+    r.frame_target_pelvis.push_back(fr.target_pelvis);
   };
   record_frame(0.0, 0.0);
 
@@ -110,7 +143,8 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
   for (long s = 0; s < steps; ++s) {
     const double t = (s + 1) * h;
     const BodyPose pose = motion.sample(t);
-    const StepReport rep = sim.step(target_bones(*avatar, pose), pose);
+    targets = target_bones(*avatar, pose);
+    const StepReport rep = sim.step(targets, pose);
     if (!finite_state(sim.state()) || !std::isfinite(rep.energy_after))
       fail(motion.name, ": simulation state became non-finite at step ", s + 1, " (t = ", t, " s); try a smaller --dt");
     r.step_time.push_back(t);
@@ -145,8 +179,8 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
 }
 
 ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, const Points& surface_rest,
-                           int num_reduced)
-    : file_(std::make_unique<io::Hdf5File>(path, io::Hdf5File::Mode::Write)) {
+                           int num_reduced, bool target_pelvis)
+    : file_(std::make_unique<io::Hdf5File>(path, io::Hdf5File::Mode::Write)), target_pelvis_(target_pelvis) {
   auto& f = *file_;
   f.write_matrix("/surface/faces", faces);
   f.write_matrix("/surface/rest", surface_rest);
@@ -157,6 +191,7 @@ ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, cons
   f.create_appendable("/frames/displacement", {V, 3}, true);
   f.create_appendable("/frames/joints", {24, 3});
   f.create_appendable("/frames/reduced", {num_reduced});
+  if (target_pelvis_) f.create_appendable("/frames/target_pelvis", {3});
 }
 
 ResultWriter::~ResultWriter() = default;
@@ -169,6 +204,7 @@ void ResultWriter::add_frame(const FrameData& fr) {
   f.append("/frames/displacement", fr.displacement.data());
   f.append("/frames/joints", fr.joints.data());
   f.append("/frames/reduced", fr.reduced.data());
+  if (target_pelvis_) f.append("/frames/target_pelvis", fr.target_pelvis.data());
   ++frames_;
 }
 
@@ -193,10 +229,12 @@ void ResultWriter::finish(const SimulationResult& r) {
 
 void write_simulation_result(const SimulationResult& r, const std::string& path) {
   const int nr = r.frame_reduced.empty() ? 0 : int(r.frame_reduced[0].size());
-  ResultWriter w(path, r.faces, r.surface_rest, nr);
+  require(r.frame_target_pelvis.empty() || r.frame_target_pelvis.size() == r.frame_time.size(), path, ": ",
+          r.frame_target_pelvis.size(), " target pelvis positions for ", r.frame_time.size(), " frames");
+  ResultWriter w(path, r.faces, r.surface_rest, nr, !r.frame_target_pelvis.empty());
   for (size_t i = 0; i < r.frame_time.size(); ++i)
     w.add_frame({r.frame_time[i], r.frame_step_ms[i], r.frame_positions[i], r.frame_displacement[i], r.frame_joints[i],
-                 r.frame_reduced[i]});
+                 r.frame_reduced[i], r.frame_target_pelvis.empty() ? Vec3(Vec3::Zero()) : r.frame_target_pelvis[i]});
   w.finish(r);
 }
 
@@ -226,6 +264,18 @@ SimulationResult read_simulation_result(const std::string& path) {
   for (std::int64_t i = 0; i < F; ++i) r.frame_reduced.push_back(red.row(i).transpose());
   MatXr ms = f.read_matrix("/frames/step_ms", F, 1);
   r.frame_step_ms.assign(ms.data(), ms.data() + F);
+  if (f.has("/frames/target_pelvis")) {  // absent in files written before it existed
+    const MatXr tp = f.read_matrix("/frames/target_pelvis", F, 3);
+    double sum = 0;
+    for (std::int64_t i = 0; i < F; ++i) {
+      r.frame_target_pelvis.push_back(tp.row(i).transpose());
+      const double e = (r.frame_joints[i].row(0).transpose() - r.frame_target_pelvis.back()).norm();
+      sum += e;
+      r.pelvis_error_max = std::max(r.pelvis_error_max, e);
+    }
+    r.pelvis_frames = int(F);
+    r.pelvis_error_mean = F > 0 ? sum / double(F) : 0.0;
+  }
   auto vec = [&](const std::string& name, std::vector<double>& out) {
     MatXr m = f.read_matrix(name, -1, 1);
     out.assign(m.data(), m.data() + m.rows());

@@ -57,7 +57,7 @@ TEST(ClipOps, ResampleTrimSpeed) {
 }
 
 TEST(ClipOps, AxisAngleRoundTripAndParams) {
-  for (const Vec3 aa : {Vec3(0.3, -0.2, 0.1), Vec3(0, 0, 3.0), Vec3(1e-9, 0, 0), Vec3::Zero().eval()}) {
+  for (const Vec3& aa : {Vec3(0.3, -0.2, 0.1), Vec3(0, 0, 3.0), Vec3(1e-9, 0, 0), Vec3::Zero().eval()}) {
     const Vec3 back = axis_angle_from_quaternion(quaternion_from_axis_angle(aa));
     EXPECT_NEAR((back - aa).norm(), 0.0, 1e-12) << aa.transpose();
   }

@@ -44,7 +44,9 @@ TEST(Retarget, SingleZRotationGivesTheSameSmplLocalRotation) {
   EXPECT_NEAR(clip.rotations[1][16].angularDistance(expected), 0, 1e-9);
   for (int j = 0; j < 24; ++j) {
     EXPECT_NEAR(clip.rotations[0][j].angularDistance(Quat::Identity()), 0, 1e-9) << j;
-    if (j != 16) EXPECT_NEAR(clip.rotations[1][j].angularDistance(Quat::Identity()), 0, 1e-9) << j;
+    if (j != 16) {
+      EXPECT_NEAR(clip.rotations[1][j].angularDistance(Quat::Identity()), 0, 1e-9) << j;
+    }
   }
   EXPECT_NEAR((clip.translations[1] - Vec3(0.1, 0, 0)).norm(), 0, 1e-9);
   EXPECT_NEAR(clip.translations[0].norm(), 0, 1e-12);
@@ -183,9 +185,11 @@ TEST(Retarget, CmuFilesMapAllBodyJoints) {
   if (dir.empty()) GTEST_SKIP() << "../shared/data/mocap/cmu is absent";
   const std::vector<std::pair<std::string, int>> files = {{"08_10.bvh", 276}, {"16_27.bvh", 244}, {"09_03.bvh", 129},
                                                           {"16_46.bvh", 137}, {"13_32.bvh", 337}, {"02_04.bvh", 484}};
+  MotionOptions keep_tpose;  // frame 0 (CMU's added T-pose) checks the rest alignment
+  keep_tpose.drop_first_frame_jump = false;
   for (const auto& [name, frames] : files) {
     MotionReport rep;
-    const MotionClip clip = load_motion(dir + "/" + name, {}, &rep);
+    const MotionClip clip = load_motion(dir + "/" + name, keep_tpose, &rep);
     EXPECT_EQ(rep.source_frames, frames) << name;
     EXPECT_NEAR(rep.source_fps, 120, 0.01) << name;
     EXPECT_EQ(rep.joint_map, "cmu");

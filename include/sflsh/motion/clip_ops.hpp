@@ -38,6 +38,20 @@ Eigen::Quaterniond quaternion_from_axis_angle(const Vec3& aa);
 /// Axis-angle (angle in [0, pi]) of a unit quaternion.
 Vec3 axis_angle_from_quaternion(const Eigen::Quaterniond& q);
 
+/// How far the first frame is from the second, compared with the rest of the
+/// clip. Some BVH converters (the CMU "cgspeed" release among them) add a
+/// T-pose as frame 1: the body then jumps from the T-pose into the motion
+/// within one frame (1.4-2.4 rad at 120 fps on the CMU files, whose later
+/// frame-to-frame changes stay below 0.42 rad).
+struct FirstFrameJump {
+  double angle = 0;          ///< largest local joint rotation between frames 0 and 1 (rad)
+  int joint = -1;            ///< SMPL joint of that rotation (-1: fewer than 2 frames)
+  double later_max = 0;      ///< largest one between any later neighbouring frames (rad)
+  /// angle > 0.5 rad and angle > 2.5 later_max (needs at least 3 frames).
+  bool discontinuous = false;
+};
+FirstFrameJump first_frame_jump(const MotionClip& clip);
+
 /// Checks that the clip has frames, matching rotation/translation counts,
 /// 24 unit quaternions per frame, finite values and fps > 0; throws naming the
 /// clip, the frame and the joint otherwise.

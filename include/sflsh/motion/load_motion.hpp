@@ -32,6 +32,12 @@ struct MotionOptions {
   double builtin_fps = 60;
   /// Read BVH through assimp instead of the own parser (a cross-check).
   bool bvh_via_assimp = false;
+  /// BVH/assimp files: drop the file's first frame when the body jumps from
+  /// it into the motion (first_frame_jump(), clip_ops.hpp: the T-pose some
+  /// converters add as frame 1). A simulation cannot follow such a jump: with
+  /// the CMU files' T-pose the pelvis lagged the motion by up to 0.24 m.
+  /// Applied before start/end, which count from the first kept frame.
+  bool drop_first_frame_jump = true;
 };
 
 /// What a load did, for `sflsh motion info` and simulation logs.
@@ -51,6 +57,12 @@ struct MotionReport {
   std::string units;         ///< resolved length unit (BVH/assimp)
   double metres_per_unit = 1;
   double avatar_scale = 1;
+  /// The file's first frame was dropped (MotionOptions::drop_first_frame_jump):
+  /// its largest joint rotation to the next frame (rad, joint name) and the
+  /// largest one between later frames.
+  bool dropped_first_frame = false;
+  double first_frame_jump = 0, later_max_jump = 0;
+  std::string first_frame_jump_joint;
   VecX betas;                ///< AMASS file's shape, if any
   std::string gender;        ///< AMASS file's gender, if any
 

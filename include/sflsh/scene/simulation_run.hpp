@@ -13,6 +13,10 @@
 //   /frames/joints        (Fr,24,3)    world joint positions, m
 //   /frames/reduced       (Fr,r)       reduced DoFs z
 //   /frames/step_ms       (Fr,)        mean wall time of the steps since the previous frame
+//   /frames/target_pelvis (Fr,3)       world position of the motion's pelvis (SMPL joint 0 of
+//                                      the target pose on the avatar's skeleton) at the frame's
+//                                      time, m; the simulated pelvis is /frames/joints[:, 0, :].
+//                                      Absent in files written before it existed.
 //   /steps/{time, energy, grad_norm, newton_decrement, outcome, ms}   (S,) per step
 //     outcome: 0 accepted, 1 damped, 2 rejected
 #include <functional>
@@ -41,6 +45,9 @@ struct RunOptions {
   /// Keep every output frame in SimulationResult (memory: ~0.5 MB per frame
   /// for a 10k-vertex body). Long runs set false and stream with on_frame.
   bool keep_frames = true;
+  /// Start at rest in the motion's first pose (true) or moving with the
+  /// motion's velocity there (false: finite difference over the first step).
+  bool start_at_rest = false;
 };
 
 /// One output frame (what the result file stores per frame).
@@ -48,6 +55,7 @@ struct FrameData {
   double time = 0, step_ms = 0;
   Points positions, displacement, joints;
   VecX reduced;
+  Vec3 target_pelvis = Vec3::Zero();  ///< the motion's pelvis at `time` (world, m)
 };
 
 struct SimulationResult {
@@ -60,9 +68,14 @@ struct SimulationResult {
   std::vector<double> frame_time, frame_step_ms;
   std::vector<Points> frame_positions, frame_displacement, frame_joints;
   std::vector<VecX> frame_reduced;
+  std::vector<Vec3> frame_target_pelvis;  ///< empty when read from a file without it
   std::vector<double> step_time, step_energy, step_grad_norm, step_decrement, step_ms;
   std::vector<int> step_outcome;
   int num_frames = 0;  ///< output frames made (kept or not)
+  /// Distance between the simulated pelvis (joint 0) and the motion's pelvis
+  /// over the output frames (kept or not), m; pelvis_frames = 0 when unknown.
+  double pelvis_error_mean = 0, pelvis_error_max = 0;
+  int pelvis_frames = 0;
   int accepted = 0, damped = 0, rejected = 0;
   /// Where the step time goes: each energy term's evaluations and the
   /// Cholesky solve, summed over all steps (ms), in the step's term order.
@@ -76,7 +89,8 @@ struct SimulationResult {
 };
 
 /// Simulates `avatar` following `motion` from its first frame (state reset to
-/// the motion's first pose at rest). Every output frame is passed to
+/// the motion's first pose, moving with the motion unless
+/// RunOptions::start_at_rest; soft tissue undeformed). Every output frame is passed to
 /// `on_frame` (if given) as it is made. Throws if the state becomes non-finite.
 SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
                                 const std::function<void(const FrameData&)>& on_frame = {});
@@ -86,7 +100,9 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
 /// file (nothing is left at `path` if finish() is never called).
 class ResultWriter {
  public:
-  ResultWriter(const std::string& path, const Triangles& faces, const Points& surface_rest, int num_reduced);
+  /// `target_pelvis`: store FrameData::target_pelvis (/frames/target_pelvis).
+  ResultWriter(const std::string& path, const Triangles& faces, const Points& surface_rest, int num_reduced,
+               bool target_pelvis = true);
   ~ResultWriter();
   void add_frame(const FrameData& frame);
   void finish(const SimulationResult& result);
@@ -95,12 +111,16 @@ class ResultWriter {
  private:
   std::unique_ptr<io::Hdf5File> file_;
   int frames_ = 0;
+  bool target_pelvis_ = true;
 };
 
 /// Bone transforms (24 world) of a motion pose on the avatar's skeleton.
 std::vector<Isometry> target_bones(const Avatar& avatar, const BodyPose& pose);
 
+/// Writes a whole result; /frames/target_pelvis only when the result has it.
 void write_simulation_result(const SimulationResult& result, const std::string& path);
+/// Reads a result file; recomputes the pelvis error from /frames/joints and
+/// /frames/target_pelvis when the file has the latter.
 SimulationResult read_simulation_result(const std::string& path);
 
 }  // namespace sflsh

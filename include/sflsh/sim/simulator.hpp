@@ -36,7 +36,7 @@ struct SimulatorOptions {
   /// Add the soft-tissue terms (inertia, elastic, gravity if |g| > 0, damping if β > 0).
   bool soft_tissue_terms = true;
   /// Newton iterations, line search, step caps, regularization (newton_step.hpp);
-  /// defaults: 1 iteration, no line search, 5 cm / 0.5 rad caps, no diagonal shift unless H fails to factor.
+  /// defaults: 1 iteration, no line search, 5 cm / 1 rad caps, no diagonal shift unless H fails to factor.
   NewtonOptions newton;
 };
 
