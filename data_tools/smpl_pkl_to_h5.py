@@ -18,7 +18,7 @@ data_tools/README.md.
     --make-test-pkl MODEL.npz OUT.pkl   wraps an .npz model into an SMPL-like
         pickle (chumpy-style Ch objects, a csc J_regressor, protocol 2) without
         chumpy, for tests of this converter.
-    --self-test   converts such a pickle built from tests/data/tiny_smpl.npz and
+    --self-test   converts such a pickle built from the tiny test model (smpl_reference.py) and
         compares every array with h5py.
 """
 import argparse
@@ -280,8 +280,11 @@ def make_test_pkl(npz_path, out_path):
 def self_test():
     import h5py
     here = os.path.dirname(os.path.abspath(__file__))
-    npz = os.path.join(here, "..", "tests", "data", "tiny_smpl.npz")
+    sys.path.insert(0, here)
+    import smpl_reference  # the tiny test model's generator
     with tempfile.TemporaryDirectory() as tmp:
+        smpl_reference.make_fixtures(tmp)
+        npz = os.path.join(tmp, "tiny_smpl.npz")
         pkl, h5 = os.path.join(tmp, "tiny.pkl"), os.path.join(tmp, "tiny.h5")
         make_test_pkl(npz, pkl)
         raw = open(pkl, "rb").read()

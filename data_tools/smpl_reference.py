@@ -12,7 +12,7 @@ C++ code it checks:
     v_posed   = sum_j w_j G_j [I | -J_j] v_unposed + trans   (eqs. 2-3)
 
 Usage:
-    /usr/bin/python3 data_tools/smpl_reference.py make-fixtures tests/data
+    /usr/bin/python3 data_tools/smpl_reference.py make-fixtures OUT_DIR   (the build: build/test_data)
         writes tiny_smpl.npz (a random 20-vertex SMPL-format model, float32,
         compressed) and tiny_smpl_expected.npz (float64 reference outputs).
     /usr/bin/python3 data_tools/smpl_reference.py pose MODEL.npz [--betas 0.5,-1]

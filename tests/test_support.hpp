@@ -32,6 +32,9 @@ std::string sflsh_binary();
 
 /// Path of a committed fixture in tests/data/.
 inline std::string fixture(const std::string& name) { return source_dir() + "/tests/data/" + name; }
+/// Path of a fixture generated at build time (tiny_smpl.npz,
+/// tiny_smpl_expected.npz: data_tools/smpl_reference.py make-fixtures).
+inline std::string generated_fixture(const std::string& name) { return std::string(SFLSH_GENERATED_DIR) + "/" + name; }
 
 /// Expects `fn` to throw sflsh::Error whose message contains every fragment.
 template <class Fn>

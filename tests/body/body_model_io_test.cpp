@@ -22,7 +22,7 @@ namespace {
 using test::TempDir;
 using NpzArrays = std::map<std::string, io::NpyArray>;
 
-using test::fixture;
+using test::generated_fixture;
 
 using test::expect_error;
 
@@ -40,10 +40,10 @@ void expect_same_model(const BodyModel& a, const BodyModel& b) {
 }
 
 // The tiny fixture's arrays as an editable .npz map (SMPL key names and shapes).
-NpzArrays tiny_arrays() { return io::read_npz(fixture("tiny_smpl.npz")); }
+NpzArrays tiny_arrays() { return io::read_npz(generated_fixture("tiny_smpl.npz")); }
 
 TEST(BodyModelIo, ReadsSmplNpzFloat32Deflated) {
-  const BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   EXPECT_EQ(m.num_vertices(), 20);
   EXPECT_EQ(m.faces.rows(), 30);
   EXPECT_EQ(m.num_betas(), 4);
@@ -51,7 +51,7 @@ TEST(BodyModelIo, ReadsSmplNpzFloat32Deflated) {
   EXPECT_EQ(m.parents[0], -1);  // the file stores 4294967295
   EXPECT_EQ(m.parents[23], 21);
   EXPECT_EQ(m.joint_names[16], "left_shoulder");
-  EXPECT_EQ(m.source, fixture("tiny_smpl.npz"));
+  EXPECT_EQ(m.source, generated_fixture("tiny_smpl.npz"));
   // Spot values against the raw arrays: shapedirs is Fortran-ordered in the
   // file, posedirs (V, 3, 207) maps to row 3v + c.
   const NpzArrays raw = tiny_arrays();
@@ -66,7 +66,7 @@ TEST(BodyModelIo, ReadsSmplNpzFloat32Deflated) {
 
 TEST(BodyModelIo, Hdf5RoundTripKeepsEverything) {
   TempDir dir;
-  BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   m.shape_meanings = {"height", "girth", "muscle", "chest"};
   m.joint_names[0] = "hips";  // non-default names survive
   const std::string path = dir.file("tiny.h5");
@@ -104,7 +104,7 @@ TEST(BodyModelIo, Hdf5RoundTripKeepsEverything) {
 
 TEST(BodyModelIo, Hdf5DenseRegressorIsAccepted) {
   TempDir dir;
-  const BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   const NpzArrays raw = tiny_arrays();
   const std::string path = dir.file("dense.h5");
   {
@@ -120,7 +120,7 @@ TEST(BodyModelIo, Hdf5DenseRegressorIsAccepted) {
 }
 
 TEST(BodyModelIo, HashFollowsContentNotSource) {
-  const BodyModel a = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel a = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   BodyModel b = a;
   b.source = "elsewhere.h5";
   b.shape_meanings = {"a", "b", "c", "d"};
@@ -142,7 +142,7 @@ TEST(BodyModelIo, NpzWrittenByUsFloat32Compressed) {
   NpzArrays raw = tiny_arrays();
   for (auto& [k, a] : raw) a.dtype = k == "f" || k == "kintree_table" ? "<i8" : "<f4";
   io::write_npz(dir.file("ours.npz"), raw, true);
-  expect_same_model(read_body_model_npz(fixture("tiny_smpl.npz")), read_body_model_npz(dir.file("ours.npz")));
+  expect_same_model(read_body_model_npz(generated_fixture("tiny_smpl.npz")), read_body_model_npz(dir.file("ours.npz")));
 }
 
 // Each broken .npz must name the file, the key and what was expected.
@@ -169,7 +169,7 @@ TEST(BodyModelIo, BrokenNpzInputsFailWithClearMessages) {
   check([](NpzArrays& a) { a["weights"].data[0] += 0.5; }, {"bad.npz", "weights row 0"});
 
   // Truncated archive, not-an-archive, missing file.
-  const std::string good = fixture("tiny_smpl.npz");
+  const std::string good = generated_fixture("tiny_smpl.npz");
   const auto size = std::filesystem::file_size(good);
   std::filesystem::copy_file(good, dir.file("cut.npz"));
   std::filesystem::resize_file(dir.file("cut.npz"), size * 2 / 3);
@@ -208,7 +208,7 @@ TEST(BodyModelIo, BrokenHdf5InputsFailWithClearMessages) {
   check("", [](const std::string& k, io::NpyArray& a) { if (k == "f") a.data[2] = -3; }, {"bad.h5", "'f'", "-3"});
 
   // Truncated HDF5 file.
-  const BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   write_body_model_hdf5(m, dir.file("ok.h5"));
   std::filesystem::resize_file(dir.file("ok.h5"), std::filesystem::file_size(dir.file("ok.h5")) / 2);
   expect_error([&] { read_body_model_hdf5(dir.file("ok.h5")); }, {"ok.h5"});
@@ -223,7 +223,7 @@ TEST(BodyModelIo, LoadBodyModelPicksReaderByExtension) {
   TempDir dir;
   expect_error([&] { load_body_model(dir.file("model.pkl")); }, {"model.pkl", "smpl_pkl_to_h5.py"});
   expect_error([&] { load_body_model(dir.file("model.obj")); }, {"model.obj", "procedural", ".npz"});
-  std::filesystem::copy_file(fixture("tiny_smpl.npz"), dir.file("UPPER.NPZ"));
+  std::filesystem::copy_file(generated_fixture("tiny_smpl.npz"), dir.file("UPPER.NPZ"));
   EXPECT_EQ(load_body_model(dir.file("UPPER.NPZ")).num_vertices(), 20);
 }
 
@@ -255,10 +255,10 @@ TEST(BodyModelIo, PickleConverterMatchesNpzReader) {
   const std::string script = test::source_dir() + "/data_tools/smpl_pkl_to_h5.py";
   const std::string pkl = dir.file("tiny.pkl"), h5 = dir.file("tiny.h5");
   std::string out;
-  ASSERT_EQ(test::run_command(py + " " + script + " --make-test-pkl " + fixture("tiny_smpl.npz") + " " + pkl, &out), 0)
+  ASSERT_EQ(test::run_command(py + " " + script + " --make-test-pkl " + generated_fixture("tiny_smpl.npz") + " " + pkl, &out), 0)
       << out;
   ASSERT_EQ(test::run_command(py + " " + script + " " + pkl + " " + h5, &out), 0) << out;
-  expect_same_model(read_body_model_npz(fixture("tiny_smpl.npz")), read_body_model_hdf5(h5));
+  expect_same_model(read_body_model_npz(generated_fixture("tiny_smpl.npz")), read_body_model_hdf5(h5));
   // A broken pickle is reported, not crashed on.
   std::ofstream(dir.file("junk.pkl")) << "junk";
   EXPECT_NE(test::run_command(py + " " + script + " " + dir.file("junk.pkl") + " " + dir.file("j.h5"), &out), 0);

@@ -20,7 +20,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-using test::fixture;
+using test::generated_fixture;
 
 using test::expect_error;
 
@@ -112,9 +112,9 @@ TEST(BodyModel, ShapeBlendShapesMoveRegressedJoints) {
 // The committed numpy reference (data_tools/smpl_reference.py) on a random
 // float32 SMPL-format model with non-zero pose directions and a sparse regressor.
 TEST(BodyModel, MatchesNumpyReference) {
-  const BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   ASSERT_TRUE(m.has_pose_blend_shapes());
-  const auto expected = io::read_npz(fixture("tiny_smpl_expected.npz"));
+  const auto expected = io::read_npz(generated_fixture("tiny_smpl_expected.npz"));
   const int cases = int(expected.at("num_cases").data.at(0));
   ASSERT_EQ(cases, 3);
   auto points = [&](const std::string& key) {
@@ -137,12 +137,14 @@ TEST(BodyModel, MatchesNumpyReference) {
       EXPECT_LT((*got - want).cwiseAbs().maxCoeff(), 1e-9) << p << key;
     }
     // Posing moved the vertices (not a trivial pass-through) in the posed cases.
-    if (c > 0) EXPECT_GT((r.v_posed - r.v_shaped).norm(), 0.1) << p;
+    if (c > 0) {
+      EXPECT_GT((r.v_posed - r.v_shaped).norm(), 0.1) << p;
+    }
   }
 }
 
 TEST(BodyModel, JointTransformsMapRestJointsAndRigidVertices) {
-  const BodyModel m = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel m = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0.0, 0.6);
   BodyPose pose;
@@ -166,7 +168,7 @@ TEST(BodyModel, JointTransformsMapRestJointsAndRigidVertices) {
 }
 
 TEST(BodyModel, ValidateNamesTheOffendingArray) {
-  const BodyModel good = read_body_model_npz(fixture("tiny_smpl.npz"));
+  const BodyModel good = read_body_model_npz(generated_fixture("tiny_smpl.npz"));
   ASSERT_NO_THROW(good.validate());
   auto broken = [&](auto edit, std::initializer_list<std::string> fragments) {
     BodyModel m = good;

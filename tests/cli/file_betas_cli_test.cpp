@@ -72,7 +72,7 @@ TEST(FileBetas, BadInputFailsWithOneClearLineAndNoOutput) {
   a.model_source = dir.file("no_such_model.h5");
   write_avatar(a, dir.file("missing.h5"));
   // A relative model path is also looked up next to the avatar (found there: then the hash differs).
-  std::filesystem::copy_file(test::fixture("tiny_smpl.npz"), dir.file("tiny_smpl.npz"));
+  std::filesystem::copy_file(test::generated_fixture("tiny_smpl.npz"), dir.file("tiny_smpl.npz"));
   a.model_source = "tiny_smpl.npz";
   write_avatar(a, dir.file("relative.h5"));
   write_motion(dir.file("betas.npz"), {0.5, -0.5});

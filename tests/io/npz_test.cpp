@@ -19,7 +19,7 @@ namespace {
 
 using test::TempDir;
 
-using test::fixture;
+using test::generated_fixture;
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -106,7 +106,7 @@ TEST(Npz, WriteRejectsInconsistentArrays) {
 // '<U' array and an object array.
 TEST(Npz, ReadsNumpyFilesWithStringsAndObjects) {
   std::map<std::string, std::vector<std::string>> strings;
-  const auto arrays = read_npz(fixture("tiny_smpl.npz"), &strings);
+  const auto arrays = read_npz(generated_fixture("tiny_smpl.npz"), &strings);
   EXPECT_EQ(arrays.count("bs_style"), 0u);  // object array skipped
   EXPECT_EQ(arrays.count("gender"), 0u);    // strings go to `strings`
   ASSERT_EQ(strings.count("gender"), 1u);
@@ -119,7 +119,7 @@ TEST(Npz, ReadsNumpyFilesWithStringsAndObjects) {
   EXPECT_EQ(kt.data[0], 4294967295.0);
   EXPECT_EQ(kt.data[24 + 23], 23.0);
 
-  const auto info = list_npz(fixture("tiny_smpl.npz"));
+  const auto info = list_npz(generated_fixture("tiny_smpl.npz"));
   bool saw_object = false;
   for (const auto& e : info) saw_object = saw_object || (e.key == "bs_style" && e.dtype == "|O");
   EXPECT_TRUE(saw_object);

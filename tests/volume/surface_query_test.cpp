@@ -41,7 +41,9 @@ TEST(SurfaceQuery, SignedDistanceAgreesWithRayParityAndExactDistance) {
     EXPECT_EQ(sd < 0, l1 < 1) << x.transpose();
     EXPECT_EQ(q.inside(x), l1 < 1) << x.transpose();
     inside += l1 < 1;
-    if (l1 < 1) EXPECT_NEAR(-sd, (1 - l1) / std::sqrt(3.0), 1e-12);  // distance to the nearest face plane
+    if (l1 < 1) {  // distance to the nearest face plane
+      EXPECT_NEAR(-sd, (1 - l1) / std::sqrt(3.0), 1e-12);
+    }
     EXPECT_NEAR(std::abs(sd), q.distance(x), 1e-12);
   }
   EXPECT_GT(inside, 50);  // the octahedron fills 4/81 of the box

@@ -222,7 +222,9 @@ TEST(TemplateVolume, BoundaryRolesDepthsAndWeights) {
     skinned += tv.node_role[n] == int(NodeRole::Skinned);
     // Skinned nodes belong to the "head" cap: paths from the spine end at
     // y = 0.2 fan out into it, so their interior nodes reach slightly below.
-    if (tv.node_role[n] == int(NodeRole::Skinned)) EXPECT_GT(tv.tet.nodes(n, 1), 0.16);
+    if (tv.node_role[n] == int(NodeRole::Skinned)) {
+      EXPECT_GT(tv.tet.nodes(n, 1), 0.16);
+    }
   }
   EXPECT_GT(skinned, 0);
   EXPECT_LT(tv.report.max_path_residual, 5e-3);
