@@ -321,7 +321,9 @@ TEST(ShapeVolume, AvatarGeometryFields) {
     EXPECT_NEAR(a.surface_bary.row(v).sum(), 1.0, 1e-12);
     const double err = (y - a.surface_rest.row(v).transpose()).norm();
     EXPECT_LT(err, 4e-3);  // coarse test mesh (facet_distance 1.5 mm)
-    if (s.report.num_embedded_outside == 0) EXPECT_LT(err, 1e-6);
+    if (s.report.num_embedded_outside == 0) {
+      EXPECT_LT(err, 1e-6);
+    }
   }
   EXPECT_LT(s.report.max_embedding_distance, 4e-3);
   EXPECT_EQ(a.tet_region.size(), T);
