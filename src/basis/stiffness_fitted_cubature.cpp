@@ -1,6 +1,5 @@
 #include "sflsh/basis/stiffness_fitted_cubature.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -13,28 +12,6 @@ namespace {
 
 using Vec9 = Eigen::Matrix<double, 9, 1>;
 using HandleGradients = std::vector<std::pair<int, Vec3>>;  // (handle k, d_{t,k}), sorted by k
-
-/// d_{t,k} for the handles touching tet t (Dirichlet nodes carry no W).
-HandleGradients handle_gradients(const TetMesh& mesh, const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
-                                 const VecXi& node_role, int t) {
-  const Vec3 x0 = mesh.nodes.row(mesh.elements(t, 0)).transpose();
-  Mat3 Dm;
-  for (int c = 1; c < 4; ++c) Dm.col(c - 1) = mesh.nodes.row(mesh.elements(t, c)).transpose() - x0;
-  const Mat3 Dinv = Dm.inverse();
-  HandleGradients out;
-  for (int c = 0; c < 4; ++c) {
-    const int n = mesh.elements(t, c);
-    if (node_role.size() && node_role[n] != int(NodeRole::Simulated)) continue;
-    const Vec3 grad = c == 0 ? Vec3(-Dinv.colwise().sum().transpose()) : Vec3(Dinv.row(c - 1).transpose());
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(W, n); it; ++it) {
-      auto pos = std::lower_bound(out.begin(), out.end(), int(it.col()),
-                                  [](const auto& e, int k) { return e.first < k; });
-      if (pos == out.end() || pos->first != it.col()) pos = out.insert(pos, {int(it.col()), Vec3::Zero()});
-      pos->second += it.value() * grad;
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -51,12 +28,13 @@ Cubature stiffness_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatri
 
   // Full tensor T_{kl} (k ≤ l) over all tets.
   const VecX vol = tet_volumes(mesh);
+  const std::vector<TetGradient> grads = tet_gradients(mesh);
   std::vector<Mat3> T(size_t(K) * K, Mat3::Zero());
   std::vector<char> used(size_t(K) * K, 0);
   double volume = 0;
   for (int t = 0; t < mesh.num_elements(); ++t) {
     volume += vol[t];
-    const HandleGradients d = handle_gradients(mesh, W, node_role, t);
+    const HandleGradients d = handle_gradients(mesh, grads[t], W, node_role, t);
     const double s = vol[t] * modulus(t);
     for (size_t i = 0; i < d.size(); ++i)
       for (size_t j = i; j < d.size(); ++j) {
@@ -88,7 +66,7 @@ Cubature stiffness_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatri
   b[rows] = kVolumeRowWeight;
   for (int s = 0; s < n; ++s) {
     const int t = candidates.elements[s];
-    const HandleGradients d = handle_gradients(mesh, W, node_role, t);
+    const HandleGradients d = handle_gradients(mesh, grads[t], W, node_role, t);
     for (size_t i = 0; i < d.size(); ++i)
       for (size_t j = i; j < d.size(); ++j) {
         const size_t p = size_t(d[i].first) * K + d[j].first;

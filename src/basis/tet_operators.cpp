@@ -1,5 +1,6 @@
 #include "sflsh/basis/tet_operators.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include "sflsh/core/error.hpp"
@@ -48,6 +49,23 @@ std::vector<TetGradient> tet_gradients(const TetMesh& mesh) {
     grads[e].row(0) = -Dinv.colwise().sum();
   }
   return grads;
+}
+
+std::vector<std::pair<int, Vec3>> handle_gradients(const TetMesh& mesh, const TetGradient& grad,
+                                                   const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
+                                                   const VecXi& node_role, int t) {
+  std::vector<std::pair<int, Vec3>> out;
+  for (int c = 0; c < 4; ++c) {
+    const int n = mesh.elements(t, c);
+    if (node_role.size() && node_role[n] != 0) continue;  // Dirichlet: u = 0
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(W, n); it; ++it) {
+      auto pos = std::lower_bound(out.begin(), out.end(), int(it.col()),
+                                  [](const auto& e, int k) { return e.first < k; });
+      if (pos == out.end() || pos->first != it.col()) pos = out.insert(pos, {int(it.col()), Vec3::Zero()});
+      pos->second += it.value() * grad.row(c).transpose();
+    }
+  }
+  return out;
 }
 
 Eigen::SparseMatrix<double> stiffness_laplacian(const TetMesh& mesh) {

@@ -86,7 +86,7 @@ FullFem::FullFem(std::shared_ptr<const Avatar> avatar, FullFemOptions options)
     }
   require(!free_node_.empty(), "FullFem: the avatar has no Simulated nodes");
 
-  grads_ = tet_shape_gradients(a.tet);
+  grads_ = basis::tet_gradients(a.tet);
   volume_.resize(T);
   mass_ = VecX::Zero(N);
   for (int t = 0; t < T; ++t) {
@@ -182,7 +182,7 @@ double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
   // Elasticity, every tet.
   for (int t = 0; t < a.tet.num_elements(); ++t) {
     Mat3 F = Mat3::Identity();
-    for (int c = 0; c < 4; ++c) F += u.row(a.tet.elements(t, c)).transpose() * grads_.block<1, 3>(t, 3 * c);
+    for (int c = 0; c < 4; ++c) F += u.row(a.tet.elements(t, c)).transpose() * grads_[t].row(c);
     Mat3 P;
     Mat9 H9;
     const double psi = strain_energy_density(F, materials_[t], grad ? &P : nullptr,
@@ -192,14 +192,14 @@ double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
     if (grad)
       for (int c = 0; c < 4; ++c) {
         const int f = node_free_[a.tet.elements(t, c)];
-        if (f >= 0) grad->segment<3>(3 * f) += volume_[t] * (P * grads_.block<1, 3>(t, 3 * c).transpose());
+        if (f >= 0) grad->segment<3>(3 * f) += volume_[t] * (P * grads_[t].row(c).transpose());
       }
     if (hessian) {
       // K(3c + i, 3d + k) = V Σ_{b,l} ∇N_c[b] H9(i + 3b, k + 3l) ∇N_d[l].
       const int* slots = &tet_slot_[size_t(t) * 144];
       for (int c = 0; c < 4; ++c)
         for (int d = 0; d < 4; ++d) {
-          const Vec3 gc = grads_.block<1, 3>(t, 3 * c).transpose(), gd = grads_.block<1, 3>(t, 3 * d).transpose();
+          const Vec3 gc = grads_[t].row(c).transpose(), gd = grads_[t].row(d).transpose();
           for (int i = 0; i < 3; ++i)
             for (int k = 0; k < 3; ++k) {
               const int s = slots[12 * (3 * c + i) + 3 * d + k];

@@ -3,6 +3,7 @@
 // shape-function gradients, the stiffness ("cotangent") Laplacian and the mass
 // matrices. libigl's cotmatrix/massmatrix, with the sign convention of FEM
 // stiffness: L is positive semi-definite.
+#include <utility>
 #include <vector>
 
 #include <Eigen/Sparse>
@@ -22,6 +23,14 @@ VecX tet_volumes(const TetMesh& mesh);
 /// Fails (naming the tet) if a tet is degenerate or inverted, because every
 /// operator below would be meaningless there.
 std::vector<TetGradient> tet_gradients(const TetMesh& mesh);
+
+/// Gradients of a reduced basis in tet t: d_{t,k} = Σ_n W_{n,k} ∇φ_n (1/m) for
+/// the columns k of W (#N by #K) that are non-zero at a node of t, sorted by
+/// k. Nodes whose `node_role` is not Simulated (0) carry no W (empty role: all
+/// do). `grad` is tet t's entry of tet_gradients.
+std::vector<std::pair<int, Vec3>> handle_gradients(const TetMesh& mesh, const TetGradient& grad,
+                                                   const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
+                                                   const VecXi& node_role, int t);
 
 /// #N by #N stiffness Laplacian L = Σ_e V_e G_eᵀ G_e (m), with G_e the 3 by 4
 /// gradient matrix of tet e. Symmetric PSD; rows sum to zero; L·f = 0 at

@@ -2,32 +2,12 @@
 
 #include <cmath>
 #include <limits>
-#include <map>
+#include <vector>
 
+#include "sflsh/basis/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh {
-
-MatXr tet_shape_gradients(const TetMesh& mesh) {
-  MatXr grads(mesh.num_elements(), 12);
-  for (int t = 0; t < mesh.num_elements(); ++t) {
-    const Vec3 x0 = mesh.nodes.row(mesh.elements(t, 0)).transpose();
-    Mat3 Dm;
-    for (int c = 1; c < 4; ++c) Dm.col(c - 1) = mesh.nodes.row(mesh.elements(t, c)).transpose() - x0;
-    const double det = Dm.determinant();
-    require(det > 0 && std::isfinite(det), "tet_shape_gradients: tet ", t, " has 6·volume ", det,
-            ", expected > 0 (positively oriented, non-degenerate)");
-    // N_c(x) = (Dm⁻¹ (x − x0))_c for c = 1..3, N_0 = 1 − Σ: ∇N_c = row c−1 of Dm⁻¹.
-    const Mat3 Dinv = Dm.inverse();
-    Vec3 g0 = Vec3::Zero();
-    for (int c = 1; c < 4; ++c) {
-      grads.block<1, 3>(t, 3 * c) = Dinv.row(c - 1);
-      g0 -= Dinv.row(c - 1).transpose();
-    }
-    grads.block<1, 3>(t, 0) = g0.transpose();
-  }
-  return grads;
-}
 
 Mat3 tet_frame(const Avatar& a, int t) {
   if (a.tet_frames.size() == 0) return Mat3::Identity();
@@ -51,29 +31,6 @@ const RegionMaterial& tet_material(const Avatar& a, int t) {
 }
 
 namespace {
-
-/// d_{t,h} = Σ_n W_{n,h} ∇N_n for the handles h touching tet t (Dirichlet
-/// nodes have u = 0 and contribute nothing), sorted by h.
-std::map<int, Vec3> handle_gradients(const Avatar& a, int t) {
-  Mat3 Dm;
-  const Vec3 x0 = a.tet.nodes.row(a.tet.elements(t, 0)).transpose();
-  for (int c = 1; c < 4; ++c) Dm.col(c - 1) = a.tet.nodes.row(a.tet.elements(t, c)).transpose() - x0;
-  const double det = Dm.determinant();
-  require(det > 0 && std::isfinite(det), "ElasticTerm: tet ", t, " has 6·volume ", det,
-          ", expected > 0 (positively oriented, non-degenerate)");
-  const Mat3 Dinv = Dm.inverse();
-  std::map<int, Vec3> d;
-  for (int c = 0; c < 4; ++c) {
-    const int n = a.tet.elements(t, c);
-    if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
-    const Vec3 grad = c == 0 ? Vec3(-Dinv.colwise().sum().transpose()) : Vec3(Dinv.row(c - 1).transpose());
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
-      auto [pos, inserted] = d.try_emplace(int(it.col()), Vec3::Zero());
-      pos->second += it.value() * grad;
-    }
-  }
-  return d;
-}
 
 /// hess(z-block) += Gᵀ Hw G for a sample whose F depends on the handles
 /// `handle[0..m)` through `d[0..m)`: G(a + 3b, 3e + c) = δ_ac d_e[b], so
@@ -105,11 +62,12 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   require(a.W.rows() == a.tet.num_nodes() && a.W.cols() == a.num_handles(), "ElasticTerm: W is ", a.W.rows(),
           " by ", a.W.cols(), ", expected #N = ", a.tet.num_nodes(), " by #K = ", a.num_handles());
   weight_ = cub.weights;
+  const std::vector<basis::TetGradient> grads = basis::tet_gradients(a.tet);
   for (int k = 0; k < cub.size(); ++k) {
     const int t = cub.elements[k];
     require(t >= 0 && t < a.tet.num_elements(), "ElasticTerm: sample ", k, " has tet ", t, ", expected in [0, ",
             a.tet.num_elements(), ")");
-    for (const auto& [h, v] : handle_gradients(a, t)) {
+    for (const auto& [h, v] : basis::handle_gradients(a.tet, grads[t], a.W, a.node_role, t)) {
       handle_.push_back(h);
       d_.push_back(v);
     }
@@ -120,20 +78,17 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   if (!exact_quadratic_) return;
   // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
   K_ = MatX::Zero(num_reduced_, num_reduced_);
+  const VecX volume = basis::tet_volumes(a.tet);
   std::vector<Eigen::Matrix<double, 3, 9>> T;
   std::vector<int> handle;
   std::vector<Vec3> d;
   for (int t = 0; t < a.tet.num_elements(); ++t) {
-    const std::map<int, Vec3> grads = handle_gradients(a, t);
-    if (grads.empty()) continue;
     handle.clear();
     d.clear();
-    for (const auto& [h, v] : grads) handle.push_back(h), d.push_back(v);
-    Mat3 Dm;
-    const Vec3 x0 = a.tet.nodes.row(a.tet.elements(t, 0)).transpose();
-    for (int c = 1; c < 4; ++c) Dm.col(c - 1) = a.tet.nodes.row(a.tet.elements(t, c)).transpose() - x0;
-    const double volume = Dm.determinant() / 6.0;
-    const Mat9 H2 = volume * linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
+    for (const auto& [h, v] : basis::handle_gradients(a.tet, grads[t], a.W, a.node_role, t))
+      handle.push_back(h), d.push_back(v);
+    if (handle.empty()) continue;
+    const Mat9 H2 = volume[t] * linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
     add_sample_hessian(H2, handle.data(), d.data(), int(handle.size()), 0, K_, T);
   }
 }

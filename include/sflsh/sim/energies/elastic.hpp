@@ -47,11 +47,6 @@ class ElasticTerm : public EnergyTerm {
   bool exact_quadratic_ = true;
 };
 
-/// #T by 4 by 3 shape-function gradients: row t holds ∇N_0..∇N_3 (1/m) of tet t
-/// in the unposed space, as #T by 12 (∇N_c at columns 3c..3c+2). Throws on a
-/// degenerate or inverted tet (naming it).
-MatXr tet_shape_gradients(const TetMesh& mesh);
-
 /// Frame of tet t from avatar.tet_frames (row-major 3x3), or the identity when
 /// the asset has no frames.
 Mat3 tet_frame(const Avatar& avatar, int t);
