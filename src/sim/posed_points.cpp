@@ -4,6 +4,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/rotation.hpp"
+#include "sflsh/sim/skeleton_pose.hpp"
 
 namespace sflsh {
 namespace {
@@ -206,11 +207,7 @@ Points surface_pose_offsets(const Avatar& a, const std::vector<Isometry>& bones)
 }
 
 Points posed_joints(const Avatar& a, const std::vector<Isometry>& bones) {
-  require(a.joints_rest.rows() == int(bones.size()), "posed_joints: ", bones.size(), " bones but ",
-          a.joints_rest.rows(), " rest joints");
-  Points J(bones.size(), 3);
-  for (int j = 0; j < int(bones.size()); ++j) J.row(j) = (bones[j] * Vec3(a.joints_rest.row(j).transpose())).transpose();
-  return J;
+  return joint_world_positions(bones, a.joints_rest);
 }
 
 }  // namespace sflsh

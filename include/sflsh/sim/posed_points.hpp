@@ -72,7 +72,7 @@ class PosedPoints {
 /// Zero when the asset has no pose blend shapes.
 Points surface_pose_offsets(const Avatar& avatar, const std::vector<Isometry>& bones);
 
-/// 24 by 3 world joint positions G_j · joints_rest[j] (m).
+/// 24 by 3 world joint positions G_j · joints_rest[j] (m): joint_world_positions on the avatar.
 Points posed_joints(const Avatar& avatar, const std::vector<Isometry>& bones);
 
 }  // namespace sflsh
