@@ -42,16 +42,7 @@ TEST(JointConstraint, DerivativesMatchFiniteDifferences) {
   // Unconnected random bones: gradient and residual Jacobians.
   const Configuration q = test::random_bones(rng, 1.0, 0.3);
   const StepContext ctx = test::skeleton_context(a, q);
-  VecX g = VecX::Zero(n);
-  MatX H = MatX::Zero(n, n);
-  term.evaluate(ctx, q, &g, &H);
-  EXPECT_LT(test::rel_error(g, test::fd_gradient(term, ctx, q)), 1e-6);
-  VecX r;
-  MatX J;
-  test::stacked_residuals(term, ctx, q, r, &J);
-  EXPECT_EQ(r.size(), 3 * 23);
-  EXPECT_LT(test::rel_error(J, test::fd_residual_jacobian(term, ctx, q)), 1e-7);
-  EXPECT_GT(test::min_eigenvalue(H), -1e-9 * H.norm());
+  test::expect_residual_derivatives_match(term, ctx, q, 3 * 23);
 
   // Connected skeleton (zero residual): Gauss–Newton = exact Hessian.
   const Configuration q0 =

@@ -3,8 +3,10 @@
 // compiled): a small T-pose SMPL skeleton, random configurations and
 // finite differences in the tangent space (perturbations through retract).
 #include <random>
-#include <Eigen/Eigenvalues>
 #include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/smpl_skeleton.hpp"
@@ -158,6 +160,27 @@ inline double rel_error(const MatX& a, const MatX& b, double floor = 1e-12) {
 /// Smallest eigenvalue of the symmetric part of H.
 inline double min_eigenvalue(const MatX& H) {
   return Eigen::SelfAdjointEigenSolver<MatX>(0.5 * (H + H.transpose()), Eigen::EigenvaluesOnly).eigenvalues()(0);
+}
+
+/// Checks a bone least-squares term at q: its gradient and stacked residual
+/// Jacobian against finite differences (relative 1e-6 / 1e-7), `rows` stacked
+/// residuals when rows ≥ 0, and a PSD (Gauss–Newton) Hessian. Returns that Hessian.
+inline MatX expect_residual_derivatives_match(const BoneLeastSquaresTerm& term, const StepContext& ctx,
+                                              const Configuration& q, int rows = -1) {
+  const int n = ctx.layout.size();
+  VecX g = VecX::Zero(n);
+  MatX H = MatX::Zero(n, n);
+  term.evaluate(ctx, q, &g, &H);
+  EXPECT_LT(rel_error(g, fd_gradient(term, ctx, q)), 1e-6);
+  VecX r;
+  MatX J;
+  stacked_residuals(term, ctx, q, r, &J);
+  if (rows >= 0) {
+    EXPECT_EQ(r.size(), rows);
+  }
+  EXPECT_LT(rel_error(J, fd_residual_jacobian(term, ctx, q)), 1e-7);
+  EXPECT_GT(min_eigenvalue(H), -1e-9 * H.norm());
+  return H;
 }
 
 }  // namespace sflsh::test
