@@ -10,6 +10,7 @@
 
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/fnv_hash.hpp"
 #include "sflsh/core/memory.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
@@ -29,13 +30,9 @@ std::string template_key(const BodyModel& model, const TemplateOptions& o) {
     << o.mesh.perturb_sliver_bound_deg << '|' << o.mesh.exude_sliver_bound_deg << '|'
     << o.mesh.remove_boundary_slivers_below_deg << '|' << o.mesh.seed << '|' << o.sliver_repair.target_deg << '|'
     << o.sliver_repair.passes << '|' << o.skinned_size_scale << '|' << o.skinned_facet_distance << '|' << o.inner_facet_distance;
-  const std::string text = s.str();
-  // FNV-1a 64-bit over the key text.
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  std::ostringstream hex;
-  hex << std::hex << std::setw(16) << std::setfill('0') << h;
-  return hex.str();
+  Fnv1a64 h;
+  h.add(s.str());
+  return h.hex();
 }
 
 // Skin thickness at each node: distance to its skeleton point (handles go

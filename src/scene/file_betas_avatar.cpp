@@ -1,7 +1,6 @@
 #include "sflsh/scene/file_betas_avatar.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -11,6 +10,7 @@
 #include "sflsh/asset/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/fnv_hash.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/io/hdf5_file.hpp"
@@ -19,21 +19,6 @@
 namespace sflsh {
 namespace fs = std::filesystem;
 namespace {
-
-// FNV-1a 64-bit, as the template-stage cache keys (precompute.cpp).
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ull;
-  void add(const void* data, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-  }
-  void add(const std::string& s) { add(s.data(), s.size()); }
-  std::string hex() const {
-    std::ostringstream o;
-    o << std::hex << std::setw(16) << std::setfill('0') << h;
-    return o.str();
-  }
-};
 
 bool is_procedural(const std::string& source) { return source == "procedural" || source.rfind("procedural:", 0) == 0; }
 
@@ -100,7 +85,7 @@ std::string matching_template(const std::string& cache_dir, const std::string& m
 }
 
 std::string shaped_key(const Avatar& base, const VecX& betas) {
-  Fnv f;
+  Fnv1a64 f;
   std::ostringstream text;
   text << std::setprecision(17) << "avatar|" << kAvatarFormatVersion << '|' << base.model_hash << '|'
        << base.num_handles() << '|';
