@@ -8,6 +8,7 @@
 
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/motion/load_motion.hpp"
@@ -25,12 +26,6 @@ struct Trace {
   std::vector<Points> u;   // per frame, #V by 3 (m)
   std::vector<double> ms;  // per step
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, size_t(std::lround(p * double(v.size() - 1))))];
-}
 
 /// Steps per comparison frame for time step h (h must divide 1/30 s).
 int steps_per_frame(double h) {

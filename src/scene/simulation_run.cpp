@@ -6,20 +6,13 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/sim/skeleton_pose.hpp"
 
 namespace sflsh {
 namespace {
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double idx = p * double(v.size() - 1);
-  const size_t lo = size_t(std::floor(idx)), hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (idx - double(lo)) * (v[hi] - v[lo]);
-}
 
 bool finite_state(const Configuration& q) {
   if (!q.z.allFinite()) return false;

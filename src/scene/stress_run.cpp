@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/percentile.hpp"
 #include "sflsh/motion/load_motion.hpp"
 
 namespace sflsh {
@@ -65,8 +66,7 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     r.rejected += rep.rejected;
     if (step % o.window == 0 || step == o.steps) {
       w.t_end = double(step) * o.dt;
-      std::nth_element(ms.begin(), ms.begin() + long(ms.size() / 2), ms.end());
-      w.ms_median = ms[ms.size() / 2];
+      w.ms_median = percentile(ms, 0.5);
       r.windows.push_back(w);
       w = StressWindow();
       w.min_det = std::numeric_limits<double>::infinity();
