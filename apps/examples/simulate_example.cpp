@@ -17,10 +17,11 @@ int main(int argc, char** argv) {
   try {
     auto avatar = std::make_shared<sflsh::Avatar>(sflsh::read_avatar(argv[1]));
     const sflsh::MotionClip motion = sflsh::load_motion(argc > 2 ? argv[2] : "builtin:jump");
-    sflsh::Simulator sim(avatar);  // bones prescribed by the motion, soft tissue dynamic
+    // One avatar, bones prescribed by the motion, soft tissue dynamic.
+    sflsh::Simulator sim(sflsh::avatar_model(avatar, sflsh::SimulatorOptions{}));
     sim.reset(sflsh::target_bones(*avatar, motion.sample(0.0)));
     for (int s = 1; s <= 120; ++s) {
-      const sflsh::BodyPose pose = motion.sample(s * sim.options().h);
+      const sflsh::BodyPose pose = motion.sample(s * sim.h());
       const sflsh::StepReport report = sim.step(sflsh::target_bones(*avatar, pose), pose);
       if (s % 30 == 0) {
         const sflsh::Points u = sim.soft_displacement();  // #V by 3, unposed space

@@ -21,7 +21,7 @@ namespace {
 
 struct SimulateArgs {
   std::string avatar, motion = "builtin:jump", out = "result.h5", exp, render, material, dt = "1/60", bones = "dynamic";
-  std::string units = "auto", joint_map, cache_dir;
+  std::string units = "auto", joint_map, cache_dir, checkpoint, resume;
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
@@ -44,8 +44,10 @@ void run_simulate(const SimulateArgs& a) {
   o.seconds = a.seconds;
   o.output_fps = a.output_fps;
   o.start_at_rest = a.start_at_rest;
+  o.checkpoint = a.checkpoint;
+  o.resume = a.resume;
   // Check every output can be written before spending time simulating.
-  for (const std::string& p : {a.out, a.render}) {
+  for (const std::string& p : {a.out, a.render, a.checkpoint}) {
     if (p.empty()) continue;
     const auto parent = std::filesystem::path(p).parent_path();
     require(parent.empty() || std::filesystem::is_directory(parent), p, ": output folder ", parent.string(),
@@ -133,6 +135,9 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--cache-dir", a->cache_dir,
                   "Cache of template stages and --use-file-betas avatars (default: $SFLSH_CACHE_DIR or ~/.cache/sflsh)");
   cmd->add_option("--out", a->out, "Result file (HDF5)")->capture_default_str();
+  cmd->add_option("--checkpoint", a->checkpoint, "Also save the final state (HDF5) to continue from with --resume");
+  cmd->add_option("--resume", a->resume,
+                  "Continue from a --checkpoint file: same avatar, motion and options; --seconds is the end time");
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();

@@ -66,7 +66,7 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion
   o.bones_dynamic = false;
   o.newton.iterations = newton_iters;
   o.newton.line_search = newton_iters > 1;
-  Simulator sim(avatar, o);
+  Simulator sim(avatar_model(avatar, o));
   sim.reset(target_bones(*avatar, motion.sample(0)));
   Trace tr;
   tr.u.push_back(sim.soft_displacement());

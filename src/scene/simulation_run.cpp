@@ -10,6 +10,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/sim/skeleton_pose.hpp"
+#include "sflsh/sim/state_file.hpp"
 
 namespace sflsh {
 namespace {
@@ -38,6 +39,21 @@ Vec3 pelvis_position(const Avatar& avatar, const std::vector<Isometry>& bones) {
 }
 
 }  // namespace
+
+void SimulationResult::add_step_times(const StepReport& rep) {
+  // By name, in order of first appearance: terms may come and go between steps.
+  auto add = [&](const std::string& name, double ms) {
+    const auto it = std::find(part_names.begin(), part_names.end(), name);
+    if (it != part_names.end()) {
+      part_ms[it - part_names.begin()] += ms;
+    } else {
+      part_names.push_back(name);
+      part_ms.push_back(ms);
+    }
+  };
+  for (const TermEnergy& e : rep.energies) add(e.name, e.ms);
+  add("solve", rep.ms_solve);
+}
 
 double SimulationResult::median_step_ms() const { return percentile(step_ms, 0.5); }
 double SimulationResult::p95_step_ms() const { return percentile(step_ms, 0.95); }
@@ -76,12 +92,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
   require(seconds > 0, motion.name, ": motion lasts 0 s; give a duration");
   const long steps = std::max(1L, long(std::llround(seconds / h)));
 
-  Simulator sim(avatar, options.sim);
-  if (options.sim.bones_dynamic) {
-    std::vector<EnergyTermPtr> terms;
-    add_skeleton_terms(terms, *avatar, options.skeleton);
-    for (auto& t : terms) sim.add_term(std::move(t));
-  }
+  Simulator sim(avatar_model(avatar, options.sim, options.sim.bones_dynamic ? &options.skeleton : nullptr));
   std::vector<Isometry> targets = target_bones(*avatar, motion.sample(0.0));
   if (options.start_at_rest) {
     sim.reset(targets);
@@ -97,6 +108,17 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     q_prev.z = q0.z;
     for (size_t j = 0; j < targets.size(); ++j) q_prev.bones.push_back(targets[j] * next[j].inverse() * targets[j]);
     sim.reset(q0, q_prev);
+  }
+
+  long first_step = 0;
+  if (!options.resume.empty()) {
+    sim.set_state(read_state(options.resume, sim.model()));
+    first_step = std::lround(sim.time() / h);
+    require(std::abs(sim.time() - first_step * h) <= 1e-9 * std::max(1.0, sim.time()), options.resume,
+            ": the checkpoint's time ", sim.time(), " s is not a whole number of steps of ", h, " s");
+    require(first_step <= steps, options.resume, ": the checkpoint is at ", sim.time(),
+            " s, past the run's end at ", steps * h, " s");
+    targets = target_bones(*avatar, motion.sample(sim.time()));
   }
 
   SimulationResult r;
@@ -127,13 +149,13 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     r.frame_reduced.push_back(std::move(fr.reduced));
     r.frame_target_pelvis.push_back(fr.target_pelvis);
   };
-  record_frame(0.0, 0.0);
+  record_frame(sim.time(), 0.0);
 
   const double frame_dt = 1.0 / options.output_fps;
-  double next_frame = frame_dt, ms_since_frame = 0;
+  double next_frame = (std::floor(sim.time() / frame_dt + 1e-9) + 1) * frame_dt, ms_since_frame = 0;
   int steps_since_frame = 0;
   Progress progress("simulating " + motion.name, steps);
-  for (long s = 0; s < steps; ++s) {
+  for (long s = first_step; s < steps; ++s) {
     const double t = (s + 1) * h;
     const BodyPose pose = motion.sample(t);
     targets = target_bones(*avatar, pose);
@@ -146,13 +168,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     r.step_decrement.push_back(rep.newton_decrement);
     r.step_outcome.push_back(int(rep.outcome));
     r.step_ms.push_back(rep.ms_total);
-    if (r.part_names.empty()) {
-      for (const TermEnergy& e : rep.energies) r.part_names.push_back(e.name);
-      r.part_names.push_back("solve");
-      r.part_ms.assign(r.part_names.size(), 0.0);
-    }
-    for (size_t i = 0; i < rep.energies.size() && i + 1 < r.part_ms.size(); ++i) r.part_ms[i] += rep.energies[i].ms;
-    r.part_ms.back() += rep.ms_solve;
+    r.add_step_times(rep);
     r.accepted += rep.accepted;
     r.damped += rep.damped;
     r.rejected += rep.rejected;
@@ -168,6 +184,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     if (options.progress) progress.update(s + 1);
   }
   if (options.progress) progress.finish();
+  if (!options.checkpoint.empty()) write_state(options.checkpoint, sim.model(), sim.scene_state());
   return r;
 }
 

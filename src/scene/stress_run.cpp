@@ -10,6 +10,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/percentile.hpp"
+#include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/motion/load_motion.hpp"
 
 namespace sflsh {
@@ -50,7 +51,9 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
   long step = 0;
   ro.on_step = [&](const Simulator& sim, const StepReport& rep) {
     ++step;
-    const double det = sim.elastic().min_det(sim.state().z);
+    const ElasticTerm* elastic_term = sim.model().find_term<ElasticTerm>(0);
+    require(elastic_term != nullptr, "stress: the model has no elastic term");
+    const double det = elastic_term->min_det(sim.state().z);
     const double peak = 1e3 * sim.soft_displacement().rowwise().norm().maxCoeff();
     double elastic = 0;
     for (const TermEnergy& e : rep.energies)

@@ -6,7 +6,7 @@
 namespace sflsh {
 
 Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout) {
-  require(delta.size() == layout.size(), "retract: step has ", delta.size(), " entries, expected ", layout.size());
+  require(delta.size() >= layout.end(), "retract: step has ", delta.size(), " entries, expected at least ", layout.end());
   Configuration out = q;
   if (layout.bones_dynamic) {
     const bool pivots = layout.bone_pivots.rows() > 0;

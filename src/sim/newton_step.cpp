@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <Eigen/Cholesky>
 
@@ -15,19 +16,66 @@ constexpr int kMaxHalvings = 20;
 constexpr double kArmijo = 1e-4;
 
 /// Largest scale ≤ 1 keeping every handle step and bone rotation step within the caps.
-double step_cap(const VecX& delta, const DofLayout& layout, const NewtonOptions& o) {
+double step_cap(const VecX& delta, const std::vector<DofLayout>& bodies, const NewtonOptions& o) {
   double scale = 1.0;
   if (o.max_z_step > 0) {
     double m = 0;
-    for (int k = 0; k < layout.num_reduced / 3; ++k) m = std::max(m, delta.segment<3>(layout.z_offset() + 3 * k).norm());
+    for (const DofLayout& layout : bodies)
+      for (int k = 0; k < layout.num_reduced / 3; ++k)
+        m = std::max(m, delta.segment<3>(layout.z_offset() + 3 * k).norm());
     if (m > o.max_z_step) scale = std::min(scale, o.max_z_step / m);
   }
-  if (o.max_rotation_step > 0 && layout.bones_dynamic) {
+  if (o.max_rotation_step > 0) {
     double m = 0;
-    for (int i = 0; i < layout.num_bones; ++i) m = std::max(m, delta.segment<3>(layout.bone_offset(i)).norm());
+    for (const DofLayout& layout : bodies)
+      if (layout.bones_dynamic)
+        for (int i = 0; i < layout.num_bones; ++i) m = std::max(m, delta.segment<3>(layout.bone_offset(i)).norm());
     if (m > o.max_rotation_step) scale = std::min(scale, o.max_rotation_step / m);
   }
   return scale;
+}
+
+std::vector<Configuration> retract_all(const std::vector<Configuration>& q, const VecX& delta,
+                                       const std::vector<DofLayout>& bodies) {
+  std::vector<Configuration> out;
+  out.reserve(q.size());
+  for (size_t b = 0; b < q.size(); ++b) out.push_back(retract(q[b], delta, bodies[b]));
+  return out;
+}
+
+/// Evaluates one term into the global gradient/Hessian (either may be null).
+double evaluate_term(SystemTerm& t, const std::vector<Configuration>& q, VecX* grad, MatX* hess, VecX& g_local,
+                     MatX& H_local) {
+  StepContext& ctx = *t.ctx;
+  for (BoundBody& b : ctx.bound) b.q = &q[b.slot];
+  const Configuration& q0 = ctx.bound.empty() ? q[0] : q[ctx.bound[0].slot];
+  const TermPlacement& p = t.placement;
+  if (p.local_size == 0 || (!grad && !hess)) return t.term->compute(ctx, q0, nullptr, nullptr);
+  if (p.contiguous) {
+    std::unique_ptr<VecRef> g = grad ? std::make_unique<VecRef>(grad->segment(p.offset, p.local_size)) : nullptr;
+    std::unique_ptr<MatRef> H =
+        hess ? std::make_unique<MatRef>(hess->block(p.offset, p.offset, p.local_size, p.local_size)) : nullptr;
+    return t.term->compute(ctx, q0, g.get(), H.get());
+  }
+  // Scattered: fill a local system, then add each (piece, piece) block.
+  if (grad) g_local.setZero(p.local_size);
+  if (hess) H_local.setZero(p.local_size, p.local_size);
+  std::unique_ptr<VecRef> g = grad ? std::make_unique<VecRef>(g_local) : nullptr;
+  std::unique_ptr<MatRef> H = hess ? std::make_unique<MatRef>(H_local) : nullptr;
+  const double e = t.term->compute(ctx, q0, g.get(), H.get());
+  int li = 0;
+  for (const auto& [gi, ni] : p.ranges) {
+    if (grad) grad->segment(gi, ni) += g_local.segment(li, ni);
+    if (hess) {
+      int lj = 0;
+      for (const auto& [gj, nj] : p.ranges) {
+        hess->block(gi, gj, ni, nj) += H_local.block(li, lj, ni, nj);
+        lj += nj;
+      }
+    }
+    li += ni;
+  }
+  return e;
 }
 
 /// Solves H δ = −g by Cholesky, in place in H (no copy of the ~n² matrix).
@@ -66,17 +114,32 @@ void solve_in_place(MatX& H, const VecX& g, double eps, VecX& delta, double* shi
 
 }  // namespace
 
-double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, const Configuration& q, VecX* grad,
-                    MatX* hess, std::vector<double>* per_term, std::vector<double>* term_ms) {
-  const int n = ctx.layout.size();
+TermPlacement TermPlacement::from_ranges(std::vector<std::pair<int, int>> ranges) {
+  TermPlacement p;
+  p.ranges = std::move(ranges);
+  for (const auto& r : p.ranges) p.local_size += r.second;
+  p.offset = p.ranges.empty() ? 0 : p.ranges[0].first;
+  for (size_t i = 1; i < p.ranges.size(); ++i)
+    if (p.ranges[i].first != p.ranges[i - 1].first + p.ranges[i - 1].second) p.contiguous = false;
+  return p;
+}
+
+double total_energy(StepSystem& sys, const std::vector<Configuration>& q, VecX* grad, MatX* hess,
+                    std::vector<double>* per_term, std::vector<double>* term_ms) {
+  const int n = sys.size;
   if (grad) grad->setZero(n);
   if (hess) hess->setZero(n, n);
   if (per_term) per_term->clear();
-  if (term_ms) term_ms->resize(terms.size(), 0.0);
+  if (term_ms) term_ms->resize(sys.terms.size(), 0.0);
   double E = 0;
-  for (size_t i = 0; i < terms.size(); ++i) {
+  for (size_t i = 0; i < sys.terms.size(); ++i) {
+    SystemTerm& t = sys.terms[i];
+    if (!t.active) {
+      if (per_term) per_term->push_back(0.0);
+      continue;
+    }
     Timer timer;
-    const double e = terms[i]->evaluate(ctx, q, grad, hess);
+    const double e = evaluate_term(t, q, grad, hess, sys.scratch_grad, sys.scratch_hess);
     if (term_ms) (*term_ms)[i] += timer.ms();
     if (per_term) per_term->push_back(e);
     E += e;
@@ -84,9 +147,10 @@ double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ct
   return E;
 }
 
-StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, Configuration& q,
-                           const NewtonOptions& o) {
+StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const NewtonOptions& o) {
   require(o.iterations >= 1, "NewtonOptions::iterations = ", o.iterations, ", expected >= 1");
+  require(q.size() == sys.bodies.size(), "newton_minimize: ", q.size(), " configurations for ", sys.bodies.size(),
+          " bodies");
   Timer total;
   StepReport rep;
   VecX g, g_final, delta;
@@ -95,7 +159,7 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
   bool final_valid = false;  // g_final/per_term hold the final configuration's values
   for (int it = 0; it < o.iterations; ++it) {
     Timer ta;
-    const double E0 = total_energy(terms, ctx, q, &g, &H, nullptr, &term_ms);
+    const double E0 = total_energy(sys, q, &g, &H, nullptr, &term_ms);
     rep.ms_assemble += ta.ms();
     require(std::isfinite(E0) && g.allFinite(), "newton_minimize: energy or gradient is not finite at the start of "
             "iteration ", it, " (E = ", E0, "); the configuration is inadmissible");
@@ -113,16 +177,16 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
 
-    double alpha = step_cap(delta, ctx.layout, o);
-    Configuration trial;
+    double alpha = step_cap(delta, sys.bodies, o);
+    std::vector<Configuration> trial;
     bool ok = false;
     Timer tl;
     // On the last iteration the trial evaluation doubles as the final report's.
     const bool last = it + 1 == o.iterations && o.report_final;
     for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
-      trial = retract(q, alpha * delta, ctx.layout);
-      const double E1 = total_energy(terms, ctx, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr,
-                                     &term_ms);
+      trial = retract_all(q, alpha * delta, sys.bodies);
+      const double E1 =
+          total_energy(sys, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr, &term_ms);
       final_valid = last;
       const bool admissible = std::isfinite(E1);
       if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * slope) : admissible) {
@@ -148,21 +212,45 @@ StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepCont
   }
 
   rep.energy_after = rep.grad_norm_after = std::numeric_limits<double>::quiet_NaN();
+  const size_t T = sys.terms.size();
+  if (term_ms.size() < T) term_ms.resize(T, 0.0);
   if (o.report_final) {
     if (!final_valid) {
       Timer ta;
-      total_energy(terms, ctx, q, &g_final, nullptr, &per_term, &term_ms);
+      total_energy(sys, q, &g_final, nullptr, &per_term, &term_ms);
       rep.ms_assemble += ta.ms();
     }
     rep.energy_after = 0;
     for (double e : per_term) rep.energy_after += e;
     rep.grad_norm_after = g_final.norm();
-    for (size_t i = 0; i < terms.size(); ++i) rep.energies.push_back({terms[i]->name(), per_term[i], term_ms[i]});
+    for (size_t i = 0; i < T; ++i)
+      rep.energies.push_back({sys.terms[i].term->name(), per_term[i], term_ms[i], sys.terms[i].active});
   } else {
-    for (size_t i = 0; i < terms.size(); ++i)
-      rep.energies.push_back({terms[i]->name(), std::numeric_limits<double>::quiet_NaN(), term_ms[i]});
+    for (size_t i = 0; i < T; ++i)
+      rep.energies.push_back({sys.terms[i].term->name(), std::numeric_limits<double>::quiet_NaN(), term_ms[i],
+                              sys.terms[i].active});
   }
   rep.ms_total = total.ms();
+  return rep;
+}
+
+StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, Configuration& q,
+                           const NewtonOptions& options) {
+  std::vector<StepContext> contexts(terms.size(), ctx);
+  std::vector<std::unique_ptr<TermCache>> caches;
+  StepSystem sys;
+  sys.bodies = {ctx.layout};
+  sys.size = ctx.layout.end();
+  const TermPlacement whole = TermPlacement::from_ranges({{ctx.layout.base, ctx.layout.size()}});
+  for (size_t i = 0; i < terms.size(); ++i) {
+    StepContext& c = contexts[i];
+    c.bound = {BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}};
+    caches.push_back(begin_term_step(*terms[i], c));
+    sys.terms.push_back({terms[i], &c, whole, terms[i]->active(c)});
+  }
+  std::vector<Configuration> qs{q};
+  StepReport rep = newton_minimize(sys, qs, options);
+  q = std::move(qs[0]);
   return rep;
 }
 

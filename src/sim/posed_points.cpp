@@ -123,7 +123,7 @@ Points PosedPoints::world(const Configuration& q, const Points* offsets) const {
 }
 
 void PosedPoints::add_jacobian_transpose(const Configuration& q, const DofLayout& layout, const Points& f,
-                                         VecX& grad) const {
+                                         Eigen::Ref<VecX> grad) const {
   const int z0 = layout.z_offset();
   for (int p = 0; p < size(); ++p) {
     const Vec3 y = local(p, q.z);

@@ -72,4 +72,10 @@ void add_skeleton_terms(std::vector<EnergyTermPtr>& terms, const Avatar& avatar,
                                                body_mass * std::pow(2.0 * M_PI * o.tracking_frequency_hz, 2)));
 }
 
+void add_skeleton_terms(ModelBuilder& builder, int body, const SkeletonTermsOptions& options) {
+  std::vector<EnergyTermPtr> terms;
+  add_skeleton_terms(terms, builder.avatar(body), options);
+  for (EnergyTermPtr& t : terms) builder.add_term(std::move(t), body);
+}
+
 }  // namespace sflsh

@@ -61,7 +61,7 @@ TEST(BoneInertia, ZeroAtTheConstantVelocityPrediction) {
   const Motion m = random_motion(term.bodies(), rng);
   StepContext ctx = test::skeleton_context(a, m.prev);
   ctx.q_prev2 = m.prev2;
-  term.begin_step(ctx);
+  const auto cache_term = begin_term_step(term, ctx);
   VecX g = VecX::Zero(ctx.layout.size());
   EXPECT_LT(term.evaluate(ctx, m.pred, &g, nullptr), 1e-20);
   EXPECT_LT(g.norm(), 1e-8);
@@ -74,8 +74,8 @@ TEST(BoneInertia, KineticEnergyOfATranslationIsHalfMvSquared) {
   const Avatar a = test::make_tpose_skeleton();
   BoneInertia term(bone_bodies(a, kSkeletonMass));
   const Configuration rest = test::bones_config(std::vector<Isometry>(24, Isometry::Identity()));
-  const StepContext ctx = test::skeleton_context(a, rest, 0.01);
-  term.begin_step(ctx);
+  StepContext ctx = test::skeleton_context(a, rest, 0.01);
+  const auto cache_term = begin_term_step(term, ctx);
   Configuration moved = rest;
   for (auto& G : moved.bones) G.translation() = Vec3(0.001, -0.002, 0.0);
   EXPECT_NEAR(term.evaluate(ctx, moved, nullptr, nullptr), 0.5 * kSkeletonMass * (5e-6 / 1e-4), 1e-12);
@@ -88,7 +88,7 @@ TEST(BoneInertia, DerivativesMatchFiniteDifferences) {
   const Motion m = random_motion(term.bodies(), rng);
   StepContext ctx = test::skeleton_context(a, m.prev);
   ctx.q_prev2 = m.prev2;
-  term.begin_step(ctx);
+  const auto cache_term = begin_term_step(term, ctx);
   const int n = ctx.layout.size();
 
   // Away from the prediction: gradient and residual Jacobians (which give the
@@ -110,7 +110,7 @@ TEST(BoneInertia, KinematicBonesAddNothing) {
   StepContext ctx = test::skeleton_context(a, test::random_bones(rng, 0.5, 0.2));
   ctx.layout.bones_dynamic = false;
   ctx.layout.num_reduced = 6;
-  term.begin_step(ctx);
+  const auto cache_term = begin_term_step(term, ctx);
   VecX g = VecX::Zero(6);
   MatX H = MatX::Zero(6, 6);
   const double E = term.evaluate(ctx, test::random_bones(rng, 0.5, 0.2), &g, &H);
@@ -156,8 +156,8 @@ TEST(BoneInertiaAndGravity, OneNewtonStepFromRestFallsByGravity) {
   BoneGravity gravity(bodies);
   std::mt19937 rng(15);
   const Configuration q0 = test::random_bones(rng, 1.0, 0.5);
-  const StepContext ctx = test::skeleton_context(a, q0);
-  inertia.begin_step(ctx);
+  StepContext ctx = test::skeleton_context(a, q0);
+  const auto cache_inertia = begin_term_step(inertia, ctx);
   const int n = ctx.layout.size();
   VecX g = VecX::Zero(n);
   MatX H = MatX::Zero(n, n);

@@ -59,7 +59,7 @@ TEST(Simulator, BodyAtRestStaysAtRest) {
     SimulatorOptions o;
     o.gravity = Vec3::Zero();
     o.bones_dynamic = dynamic;
-    Simulator sim(avatar(), o);
+    Simulator sim(avatar_model(avatar(), o));
     for (int i = 0; i < 30; ++i) {
       const StepReport rep = sim.step(identity_bones());
       EXPECT_EQ(rep.outcome, StepOutcome::Accepted);
@@ -76,7 +76,7 @@ TEST(Simulator, FreeFallOfTheWholeBodyMatchesGravity) {
   SimulatorOptions o;
   o.bones_dynamic = true;
   const auto a = avatar();
-  Simulator sim(a, o);
+  Simulator sim(avatar_model(a, o));
   const Vec3 c0 = centre_of_mass(*a, sim.state());
   const int n = 20;
   Vec3 c_prev = c0, c_prev2 = c0;
@@ -92,13 +92,13 @@ TEST(Simulator, FreeFallOfTheWholeBodyMatchesGravity) {
   }
   EXPECT_LT((c_prev - c0 - o.h * o.h * o.gravity * n * (n + 1) / 2.0).norm(), 1e-9);
   EXPECT_LT(sim.state().z.norm(), 1e-9);
-  EXPECT_LT(sim.elastic().min_det(sim.state().z) - 1.0, 1e-9);
+  EXPECT_LT(sim.model().find_term<ElasticTerm>(0)->min_det(sim.state().z) - 1.0, 1e-9);
 }
 
 TEST(Simulator, PrescribedBonesTrackTheMotionExactly) {
   const auto a = avatar();
-  Simulator sim(a);  // kinematic by default
-  const double h = sim.options().h;
+  Simulator sim(avatar_model(a, SimulatorOptions{}));  // kinematic by default
+  const double h = sim.h();
   double max_u = 0;
   for (int i = 1; i <= 40; ++i) {
     const auto target = test::synthetic_motion(*a, i * h);
@@ -111,14 +111,14 @@ TEST(Simulator, PrescribedBonesTrackTheMotionExactly) {
   }
   // The motion shakes the soft tissue (it is not just skinning).
   EXPECT_GT(max_u, 1e-4);
-  EXPECT_GT(sim.elastic().min_det(sim.state().z), 0.0);
+  EXPECT_GT(sim.model().find_term<ElasticTerm>(0)->min_det(sim.state().z), 0.0);
 }
 
 TEST(Simulator, SoftTissueSettlesAtTheStaticEquilibrium) {
   const auto a = avatar();
   SimulatorOptions o;
   o.gravity = Vec3(-9.81, -9.81, 0);  // sideways and down: bending and compression
-  Simulator sim(a, o);
+  Simulator sim(avatar_model(a, o));
   for (int i = 0; i < 400; ++i) sim.step(identity_bones());
   const VecX z_static = static_solution(*a, o.gravity);
   ASSERT_GT(z_static.norm(), 1e-4);
@@ -130,7 +130,7 @@ double mechanical_energy(const Simulator& sim, const InertiaTerm& inertia, const
   StepContext ctx;
   ctx.layout.bones_dynamic = false;
   ctx.layout.num_reduced = sim.avatar().num_reduced();
-  const Points v = (inertia.points().world(sim.state()) - inertia.points().world(sim.previous_state())) / sim.options().h;
+  const Points v = (inertia.points().world(sim.state()) - inertia.points().world(sim.previous_state())) / sim.h();
   double kinetic = 0;
   for (int s = 0; s < v.rows(); ++s) kinetic += 0.5 * inertia.masses()[s] * v.row(s).squaredNorm();
   return kinetic + elastic.evaluate(ctx, sim.state(), nullptr, nullptr);
@@ -150,7 +150,7 @@ TEST(Simulator, ReleasedDeformationOscillatesWithoutDampingAndDecaysWithIt) {
     o.h = 2.5e-4;
     o.gravity = Vec3::Zero();
     o.damping = beta;
-    Simulator sim(a, o);
+    Simulator sim(avatar_model(a, o));
     Configuration q0;
     q0.bones = identity_bones();
     q0.z = z0;
@@ -185,10 +185,10 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
   o.newton.iterations = 30;
   o.newton.line_search = true;
   o.newton.gradient_tolerance = 1e-12;
-  Simulator sim(a, o);
+  Simulator sim(avatar_model(a, o));
   SimulatorOptions one = o;
   one.newton = NewtonOptions();
-  Simulator sim1(a, one);
+  Simulator sim1(avatar_model(a, one));
   for (int i = 1; i <= 10; ++i) {
     const auto target = test::synthetic_motion(*a, i * o.h, 0.03, 0.5);
     const StepReport rep = sim.step(target);
@@ -199,34 +199,6 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
   }
   // One Newton step per time step stays close to the converged trajectory.
   EXPECT_LT((sim1.state().z - sim.state().z).norm(), 0.2 * sim.state().z.norm());
-}
-
-TEST(Simulator, StepTimeAtSixtyFourHandles) {
-  // Sparse basis (hat radius 8 cm: ~8 handles per node) and the dense worst case
-  // (radius 10 m: every sample touches every handle). Wall time on a shared machine.
-  for (double radius : {0.08, 10.0}) {
-    test::SyntheticAvatarOptions o;
-    o.nx = 5, o.ny = 10, o.nz = 5, o.cell = 0.03;
-    o.handles = 64;
-    o.handle_radius = radius;
-    o.all_tets = false;
-    o.samples = 150;
-    const auto a = std::make_shared<const Avatar>(test::make_synthetic_avatar(o));
-    ASSERT_EQ(a->num_reduced(), 192);
-    for (bool dynamic : {false, true}) {
-      SimulatorOptions so;
-      so.bones_dynamic = dynamic;
-      Simulator sim(a, so);
-      std::vector<double> ms;
-      for (int i = 1; i <= 40; ++i) ms.push_back(sim.step(test::synthetic_motion(*a, i * so.h)).ms_total);
-      std::sort(ms.begin(), ms.end());
-      std::cout << "[ timing   ] K = 64 (r = 192), W nnz/row " << double(a->W.nonZeros()) / a->W.rows()
-                << ", 150 elastic + 150 inertia samples, bones "
-                << (dynamic ? "dynamic (n = 336)" : "kinematic (n = 192)") << ": median " << ms[ms.size() / 2]
-                << " ms, max " << ms.back() << " ms per step\n";
-      EXPECT_LT(ms[ms.size() / 2], 50.0);  // loose: the machine is shared; the figure is reported above
-    }
-  }
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ TEST(ReducedVsFull, AllHandlesAgreeWithTheReference) {
   so.newton.line_search = true;
   so.newton.gradient_tolerance = 1e-13;
   so.newton.max_z_step = 0;
-  Simulator reduced(a, so);
+  Simulator reduced(avatar_model(a, so));
   FullFem full(a);
   std::vector<int> handle_node;  // handle k sits on Simulated node handle_node[k]
   for (int n = 0; n < a->tet.num_nodes(); ++n)

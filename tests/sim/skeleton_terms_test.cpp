@@ -102,7 +102,6 @@ FreeFall tumbling_free_fall(int iterations) {
   std::vector<Vec3> com = {skeleton_com(bodies, ctx.q_prev2.bones), skeleton_com(bodies, ctx.q_prev.bones)};
   FreeFall out;
   for (int step = 0; step < 20; ++step) {
-    for (EnergyTerm* t : terms) t->begin_step(ctx);
     Configuration q = ctx.q_prev;
     newton_minimize(terms, ctx, q, newton);
     com.push_back(skeleton_com(bodies, q.bones));
@@ -141,13 +140,10 @@ TEST(SkeletonTerms, SimulatorSkeletonFallsFromRestWithG) {
   SimulatorOptions so;
   so.bones_dynamic = true;
   so.soft_tissue_terms = false;  // the skeleton alone
-  Simulator sim(avatar, so);
   SkeletonTermsOptions o;
   o.body_mass = kBodyMass;
   o.joint_limits = o.tracking = false;
-  std::vector<EnergyTermPtr> terms;
-  add_skeleton_terms(terms, *avatar, o);
-  for (auto& t : terms) sim.add_term(std::move(t));
+  Simulator sim(avatar_model(avatar, so, &o));
   const std::vector<BoneBody> bodies = bone_bodies(*avatar, o.skeleton_mass_fraction * kBodyMass);
   const Vec3 c0 = skeleton_com(bodies, sim.state().bones);
   const int steps = 30;
@@ -187,12 +183,9 @@ std::vector<Configuration> walk(double f, const Vec3& start, bool soft_tissue) {
   SimulatorOptions so;
   so.bones_dynamic = true;
   so.soft_tissue_terms = soft_tissue;
-  Simulator sim(avatar, so);
   SkeletonTermsOptions o;
   o.body_mass = kBodyMass;
-  std::vector<EnergyTermPtr> terms;
-  add_skeleton_terms(terms, *avatar, o);
-  for (auto& t : terms) sim.add_term(std::move(t));
+  Simulator sim(avatar_model(avatar, so, &o));
   const Points& J = avatar->joints_rest;
   const auto& parents = avatar->parents;
   Configuration q0, q_1;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Sparse>
 
+#include "sflsh/core/body_pose.hpp"
 #include "sflsh/core/types.hpp"
 
 namespace sflsh {
@@ -46,12 +47,7 @@ struct BodyModel {
   void validate() const;
 };
 
-/// Pose of an SMPL body: axis-angle per joint (24 by 3, radians, relative to
-/// the parent, joint 0 = global orientation) and root translation (metres).
-struct BodyPose {
-  Points axis_angle = Points::Zero(24, 3);
-  Vec3 translation = Vec3::Zero();
-};
+// BodyPose (core/body_pose.hpp): axis-angle per joint and root translation.
 
 /// Result of the SMPL forward function.
 struct PosedBody {

@@ -48,6 +48,12 @@ struct RunOptions {
   /// Start at rest in the motion's first pose (true) or moving with the
   /// motion's velocity there (false: finite difference over the first step).
   bool start_at_rest = false;
+  /// Continue from this checkpoint (sim/state_file.hpp) instead of the
+  /// motion's first frame; the run then goes from the checkpoint's time to
+  /// `seconds` (the end time). Frames start at the checkpoint's time.
+  std::string resume;
+  /// Save the final state here (a checkpoint to resume from).
+  std::string checkpoint;
 };
 
 /// One output frame (what the result file stores per frame).
@@ -82,6 +88,8 @@ struct SimulationResult {
   std::vector<std::string> part_names;
   std::vector<double> part_ms;
 
+  /// Adds a step's per-term and solve times to part_names/part_ms.
+  void add_step_times(const StepReport& report);
   /// Median / 95th percentile step wall time (ms).
   double median_step_ms() const;
   double p95_step_ms() const;

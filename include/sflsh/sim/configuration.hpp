@@ -38,13 +38,20 @@ struct DofLayout {
   /// swinging hand 0.8 m from the pelvis otherwise opens its stiff joints by cm).
   Points bone_pivots;
 
-  int bone_offset(int i) const { return 6 * i; }      ///< valid only if bones_dynamic
-  int z_offset() const { return bones_dynamic ? 6 * num_bones : 0; }
-  int size() const { return z_offset() + num_reduced; }
+  /// Offset of this body's first DoF in the step vector it is part of (0 for
+  /// a body alone; the body's place in a scene's or a coupling term's system).
+  int base = 0;
+
+  int bone_offset(int i) const { return base + 6 * i; }  ///< valid only if bones_dynamic
+  int z_offset() const { return base + (bones_dynamic ? 6 * num_bones : 0); }
+  /// DoFs of this body: 6 per dynamic bone plus 3K.
+  int size() const { return (bones_dynamic ? 6 * num_bones : 0) + num_reduced; }
+  int end() const { return base + size(); }  ///< one past this body's last DoF
 };
 
-/// Applies a tangent step `delta` (layout.size()) to `q`: bones by the
-/// exponential map (left, world frame; about layout.bone_pivots when given), z additively.
+/// Applies a tangent step to `q`: bones by the exponential map (left, world
+/// frame; about layout.bone_pivots when given), z additively. `delta` holds at
+/// least layout.end() entries; this body's are [layout.base, layout.end()).
 Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout);
 
 }  // namespace sflsh

@@ -37,16 +37,52 @@ struct NewtonOptions {
   bool report_final = true;
 };
 
-/// Runs Newton iterations from `q` (updated in place) on Σ terms at `ctx`.
-/// All terms' begin_step must already have been called for this step.
+/// Where a term's local system (its blocks, concatenated) sits in the global
+/// step vector: pieces (global offset, size) in local order.
+struct TermPlacement {
+  std::vector<std::pair<int, int>> ranges;
+  int local_size = 0;      ///< Σ sizes
+  bool contiguous = true;  ///< one global interval [offset, offset + local_size): written in place
+  int offset = 0;          ///< its start when contiguous
+  /// Placement of the given pieces (sizes > 0).
+  static TermPlacement from_ranges(std::vector<std::pair<int, int>> ranges);
+};
+
+/// One term of a step's system: the term, its context for this step, its placement.
+struct SystemTerm {
+  const EnergyTerm* term = nullptr;
+  StepContext* ctx = nullptr;  ///< ctx->bound[i].q is pointed at the iterate before each evaluation
+  TermPlacement placement;
+  bool active = true;          ///< inactive terms are skipped (energy 0, no time)
+};
+
+/// The objective of one time step: Σ of the active terms over the bodies'
+/// configurations. The assembler adds each term's local gradient/Hessian into
+/// the global ones: in place through views when its placement is contiguous,
+/// else through `scratch` and a scatter.
+struct StepSystem {
+  std::vector<SystemTerm> terms;
+  std::vector<DofLayout> bodies;  ///< each body's global layout (retraction, step caps)
+  int size = 0;                   ///< global step vector size
+  VecX scratch_grad;              ///< scratch of scattered terms (reused)
+  MatX scratch_hess;
+};
+
+/// Σ active terms at q (one Configuration per body), adding gradient/Hessian
+/// when non-null (sized and zeroed here); per-term values go to `per_term`
+/// (0 for inactive terms) when non-null, and each term's evaluation time (ms)
+/// is added to `term_ms` (sized to #terms) when non-null.
+double total_energy(StepSystem& system, const std::vector<Configuration>& q, VecX* grad, MatX* hess,
+                    std::vector<double>* per_term = nullptr, std::vector<double>* term_ms = nullptr);
+
+/// Runs Newton iterations from `q` (one Configuration per body, updated in
+/// place) on `system`. Every term's begin_step must already have been called.
+StepReport newton_minimize(StepSystem& system, std::vector<Configuration>& q, const NewtonOptions& options);
+
+/// One body and terms sharing one context (every term's local system is the
+/// whole body, ctx.layout): the single-avatar form, for tests and tools. Calls
+/// each term's begin_step itself (with a fresh cache, begin_term_step).
 StepReport newton_minimize(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, Configuration& q,
                            const NewtonOptions& options);
-
-/// Total energy Σ terms at q, adding gradient/Hessian when non-null (sized and
-/// zeroed here); per-term values go to `per_term` when non-null, and each
-/// term's evaluation time (ms) is added to `term_ms` (sized to #terms) when non-null.
-double total_energy(const std::vector<EnergyTerm*>& terms, const StepContext& ctx, const Configuration& q,
-                    VecX* grad, MatX* hess, std::vector<double>* per_term = nullptr,
-                    std::vector<double>* term_ms = nullptr);
 
 }  // namespace sflsh

@@ -41,7 +41,7 @@ class PosedPoints {
 
   /// Adds Σ_p (∂x_p/∂δ)ᵀ f_p to `grad` (layout.size()), where f is #P by 3 and δ
   /// the tangent step at q (configuration.hpp): the generalized force of f.
-  void add_jacobian_transpose(const Configuration& q, const DofLayout& layout, const Points& f, VecX& grad) const;
+  void add_jacobian_transpose(const Configuration& q, const DofLayout& layout, const Points& f, Eigen::Ref<VecX> grad) const;
   /// Dense Jacobian J (3P by layout.size()): row 3p + c = ∂x_p[c]/∂δ at q.
   /// Row block p is multiplied by row_scale[p] when row_scale is non-empty.
   void jacobian(const Configuration& q, const DofLayout& layout, MatX& J, const VecX& row_scale = VecX()) const;

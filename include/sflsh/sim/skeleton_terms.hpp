@@ -6,6 +6,7 @@
 
 #include "sflsh/sim/energies/bone_inertia.hpp"
 #include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/model.hpp"
 
 namespace sflsh {
 
@@ -52,5 +53,7 @@ std::vector<double> joint_subtree_inertia(const Avatar& avatar, const std::vecto
 /// Appends the enabled skeletal terms to `terms`, in the order inertia,
 /// gravity, joint constraints, joint limits, tracking.
 void add_skeleton_terms(std::vector<EnergyTermPtr>& terms, const Avatar& avatar, const SkeletonTermsOptions& options);
+/// The same terms, bound to `body` of `builder`.
+void add_skeleton_terms(ModelBuilder& builder, int body, const SkeletonTermsOptions& options);
 
 }  // namespace sflsh

@@ -21,11 +21,21 @@ struct TermEnergy {
   std::string name;
   double value = 0;  ///< J, at the end of the step
   double ms = 0;     ///< time spent evaluating this term during the step (all evaluations)
+  bool active = true;  ///< false: the term sat this step out (value 0, no time)
+};
+
+/// A quantity a term reported after the step (e.g. a reaction force).
+struct TermQuantityReport {
+  std::string term;   ///< the term's name
+  int body = 0;       ///< its first bound body
+  std::string name, unit;
+  std::vector<double> value;
 };
 
 struct StepReport {
   double time = 0;                    ///< s, simulation time at the end of the step
   std::vector<TermEnergy> energies;   ///< per term, at the end of the step (J)
+  std::vector<TermQuantityReport> quantities;  ///< what terms reported (EnergyTerm::report)
   double energy_before = 0;           ///< total objective at the start configuration (J)
   double energy_after = 0;            ///< total objective at the end (J; NaN if not evaluated)
   double grad_norm_before = 0;        ///< ‖∂E/∂δ‖ at the start (mixed N / N·m units)

@@ -6,7 +6,7 @@ namespace sflsh {
 
 BoneGravity::BoneGravity(std::vector<BoneBody> bodies) : bodies_(std::move(bodies)) {}
 
-double BoneGravity::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
+double BoneGravity::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   require(q.bones.size() == bodies_.size(), "BoneGravity: configuration has ", q.bones.size(), " bones, expected ",
           bodies_.size());
   const bool assemble = ctx.layout.bones_dynamic && grad;

@@ -99,41 +99,58 @@ BoneInertia::BoneInertia(std::vector<BoneBody> bodies) : bodies_(std::move(bodie
             " needs a positive mass, got ", bodies_[i].mass);
 }
 
-void BoneInertia::begin_step(const StepContext& ctx) {
+namespace {
+
+/// Predictions of the current step.
+struct BoneInertiaCache : TermCache {
+  double h = 0.0;  ///< time step of the prediction (0 = begin_step not called)
+  std::vector<Vec3> com_pred;
+  std::vector<Mat3> rot_pred;
+  std::vector<Mat3> inertia_world;  ///< R*_i I_i,rest R*_iᵀ
+};
+
+}  // namespace
+
+std::unique_ptr<TermCache> BoneInertia::make_cache() const { return std::make_unique<BoneInertiaCache>(); }
+
+void BoneInertia::begin_step(const StepContext& ctx) const {
+  auto* cache = dynamic_cast<BoneInertiaCache*>(ctx.cache);
+  require(cache != nullptr, "BoneInertia::begin_step: the context carries no bone inertia cache (see begin_term_step)");
   const std::size_t n = bodies_.size();
   require(ctx.h > 0, "BoneInertia: time step must be positive, got ", ctx.h);
   require(ctx.q_prev.bones.size() == n, "BoneInertia: q_prev has ", ctx.q_prev.bones.size(), " bones, expected ", n);
   const bool at_rest = ctx.q_prev2.bones.empty();
   require(at_rest || ctx.q_prev2.bones.size() == n, "BoneInertia: q_prev2 has ", ctx.q_prev2.bones.size(),
           " bones, expected ", n, " (or none)");
-  h_ = ctx.h;
-  com_pred_.resize(n);
-  rot_pred_.resize(n);
-  inertia_world_.resize(n);
+  cache->h = ctx.h;
+  cache->com_pred.resize(n);
+  cache->rot_pred.resize(n);
+  cache->inertia_world.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Isometry& Gt = ctx.q_prev.bones[i];
     const Isometry& Gp = at_rest ? Gt : ctx.q_prev2.bones[i];
     const Vec3& c = bodies_[i].com_rest;
-    com_pred_[i] = 2.0 * (Gt * c) - Gp * c;
-    rot_pred_[i] = Gt.linear() * Gp.linear().transpose() * Gt.linear();
-    inertia_world_[i] = rot_pred_[i] * bodies_[i].inertia_rest * rot_pred_[i].transpose();
+    cache->com_pred[i] = 2.0 * (Gt * c) - Gp * c;
+    cache->rot_pred[i] = Gt.linear() * Gp.linear().transpose() * Gt.linear();
+    cache->inertia_world[i] = cache->rot_pred[i] * bodies_[i].inertia_rest * cache->rot_pred[i].transpose();
   }
 }
 
 void BoneInertia::residuals(const StepContext& ctx, const Configuration& q, std::vector<BoneResidual>& out) const {
-  require(h_ > 0, "BoneInertia: evaluate called before begin_step");
+  const auto* cache = dynamic_cast<const BoneInertiaCache*>(ctx.cache);
+  require(cache != nullptr && cache->h > 0, "BoneInertia: evaluate called before begin_step");
   require(q.bones.size() == bodies_.size(), "BoneInertia: configuration has ", q.bones.size(), " bones, expected ",
           bodies_.size());
-  const double inv_h2 = 1.0 / (h_ * h_);
+  const double inv_h2 = 1.0 / (cache->h * cache->h);
   for (std::size_t i = 0; i < bodies_.size(); ++i) {
     BoneResidual lin;
     const Vec3 c = q.bones[i] * bodies_[i].com_rest;
-    lin.r = c - com_pred_[i];
+    lin.r = c - cache->com_pred[i];
     lin.W = bodies_[i].mass * inv_h2 * Mat3::Identity();
     lin.bones[0] = int(i);
     lin.J[0] = point_jacobian(c);
     out.push_back(lin);
-    out.push_back(rotation_residual(q, int(i), rot_pred_[i].transpose(), -1, inv_h2 * inertia_world_[i]));
+    out.push_back(rotation_residual(q, int(i), cache->rot_pred[i].transpose(), -1, inv_h2 * cache->inertia_world[i]));
   }
 }
 

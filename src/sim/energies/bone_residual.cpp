@@ -47,8 +47,8 @@ BoneResidual rotation_residual(const Configuration& q, int a, const Mat3& C, int
   return res;
 }
 
-double accumulate_residuals(const std::vector<BoneResidual>& blocks, const DofLayout& layout, VecX* grad,
-                            MatX* hess) {
+double accumulate_residuals(const std::vector<BoneResidual>& blocks, const DofLayout& layout, VecRef* grad,
+                            MatRef* hess) {
   const bool assemble = layout.bones_dynamic && (grad || hess);
   if (grad && assemble)
     require(grad->size() == layout.size(), "skeletal term: gradient has ", grad->size(), " entries, expected ",
@@ -76,7 +76,7 @@ double accumulate_residuals(const std::vector<BoneResidual>& blocks, const DofLa
   return energy;
 }
 
-double BoneLeastSquaresTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
+double BoneLeastSquaresTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   std::vector<BoneResidual> blocks;
   residuals(ctx, q, blocks);
   return accumulate_residuals(blocks, ctx.layout, grad, hess);

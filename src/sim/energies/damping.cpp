@@ -17,7 +17,7 @@ DampingTerm::DampingTerm(const Avatar& avatar, const ElasticTerm& elastic, doubl
   elastic.evaluate(ctx, rest, &g, &K0_);
 }
 
-double DampingTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
+double DampingTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   if (beta_ == 0) return 0;
   const VecX dz = q.z - ctx.q_prev.z;
   const double c = beta_ / ctx.h;

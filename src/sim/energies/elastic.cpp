@@ -36,7 +36,7 @@ namespace {
 /// `handle[0..m)` through `d[0..m)`: G(a + 3b, 3e + c) = δ_ac d_e[b], so
 ///   T_e = Σ_b d_e[b] Hw(3b..3b+2, :)  (3x9),  block(e, f) = Σ_b' T_e(:, 3b'..) d_f[b'],
 /// ~27 m² flops instead of a dense 9 by 3m product.
-void add_sample_hessian(const Mat9& Hw, const int* handle, const Vec3* d, int m, int z0, MatX& hess,
+void add_sample_hessian(const Mat9& Hw, const int* handle, const Vec3* d, int m, int z0, MatRef hess,
                         std::vector<Eigen::Matrix<double, 3, 9>>& T) {
   T.resize(m);
   for (int e = 0; e < m; ++e)
@@ -105,7 +105,7 @@ double ElasticTerm::min_det(const VecX& z) const {
   return m;
 }
 
-double ElasticTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
+double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   require(q.z.size() == num_reduced_, "ElasticTerm: z has ", q.z.size(), " entries, expected ", num_reduced_);
   const int z0 = ctx.layout.z_offset(), S = num_samples();
   double E = 0;

@@ -7,7 +7,7 @@ namespace sflsh {
 GravityTerm::GravityTerm(const Avatar& avatar)
     : points_(PosedPoints::at_cubature(avatar, avatar.inertia)), mass_(cubature_masses(avatar, avatar.inertia)) {}
 
-double GravityTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
+double GravityTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   const Points x = points_.world(q);
   const double E = -mass_.dot(x * ctx.gravity);
   if (grad) {

@@ -16,14 +16,29 @@ VecX cubature_masses(const Avatar& avatar, const Cubature& cubature) {
 InertiaTerm::InertiaTerm(const Avatar& avatar)
     : points_(PosedPoints::at_cubature(avatar, avatar.inertia)), mass_(cubature_masses(avatar, avatar.inertia)) {}
 
-void InertiaTerm::begin_step(const StepContext& ctx) {
-  x_predicted_ = 2.0 * points_.world(ctx.q_prev) - points_.world(ctx.q_prev2);
+namespace {
+
+/// The explicit prediction x* of the current step.
+struct InertiaCache : TermCache {
+  Points x_predicted;  // #S by 3, world (m, step frame)
+};
+
+}  // namespace
+
+std::unique_ptr<TermCache> InertiaTerm::make_cache() const { return std::make_unique<InertiaCache>(); }
+
+void InertiaTerm::begin_step(const StepContext& ctx) const {
+  auto* cache = dynamic_cast<InertiaCache*>(ctx.cache);
+  require(cache != nullptr, "InertiaTerm::begin_step: the context carries no inertia cache (see begin_term_step)");
+  cache->x_predicted = 2.0 * points_.world(ctx.q_prev) - points_.world(ctx.q_prev2);
 }
 
-double InertiaTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
-  require(x_predicted_.rows() == points_.size(), "InertiaTerm::evaluate called before begin_step");
+double InertiaTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
+  const auto* cache = dynamic_cast<const InertiaCache*>(ctx.cache);
+  require(cache != nullptr && cache->x_predicted.rows() == points_.size(),
+          "InertiaTerm::compute called before begin_step");
   const double inv_h2 = 1.0 / (ctx.h * ctx.h);
-  const Points dx = points_.world(q) - x_predicted_;
+  const Points dx = points_.world(q) - cache->x_predicted;
   double E = 0;
   for (int s = 0; s < points_.size(); ++s) E += 0.5 * inv_h2 * mass_[s] * dx.row(s).squaredNorm();
   if (grad) {

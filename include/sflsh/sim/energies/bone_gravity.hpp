@@ -16,7 +16,8 @@ class BoneGravity : public EnergyTerm {
   explicit BoneGravity(std::vector<BoneBody> bodies);
   std::string name() const override { return "bone_gravity"; }
   /// V (J) with ctx.gravity (m/s²); gradient ∂V/∂ξ_i = (m_i g × c_i, −m_i g).
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  BodyBlocks blocks() const override { return BodyBlocks::Bones; }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
  private:
   std::vector<BoneBody> bodies_;

@@ -52,21 +52,15 @@ class BoneInertia : public BoneLeastSquaresTerm {
   std::string name() const override { return "bone_inertia"; }
   /// Computes the predictions c*_i, R*_i from ctx.q_prev and ctx.q_prev2 (an
   /// empty q_prev2 means "at rest").
-  void begin_step(const StepContext& ctx) override;
+  /// The predictions live in the term's cache (make_cache).
+  std::unique_ptr<TermCache> make_cache() const override;
+  void begin_step(const StepContext& ctx) const override;
   void residuals(const StepContext& ctx, const Configuration& q, std::vector<BoneResidual>& out) const override;
 
   const std::vector<BoneBody>& bodies() const { return bodies_; }
-  /// Predicted centre of mass of bone i (m, world) of the current step.
-  const Vec3& predicted_com(int i) const { return com_pred_[i]; }
-  /// Predicted rotation of bone i of the current step.
-  const Mat3& predicted_rotation(int i) const { return rot_pred_[i]; }
 
  private:
   std::vector<BoneBody> bodies_;
-  double h_ = 0.0;  ///< time step of the prediction (0 = begin_step not called)
-  std::vector<Vec3> com_pred_;
-  std::vector<Mat3> rot_pred_;
-  std::vector<Mat3> inertia_world_;  ///< R*_i I_i,rest R*_iᵀ
 };
 
 }  // namespace sflsh

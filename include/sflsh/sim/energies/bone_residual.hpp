@@ -42,8 +42,8 @@ BoneResidual rotation_residual(const Configuration& q, int a, const Mat3& C, int
 /// Adds ½ rᵀ W r for every block and returns the sum (J). If the layout
 /// solves for bones, also adds Jᵀ W r to `grad` and the Gauss–Newton Jᵀ W J
 /// to `hess` (either may be null); with kinematic bones it adds nothing.
-double accumulate_residuals(const std::vector<BoneResidual>& blocks, const DofLayout& layout, VecX* grad,
-                            MatX* hess);
+double accumulate_residuals(const std::vector<BoneResidual>& blocks, const DofLayout& layout, VecRef* grad,
+                            MatRef* hess);
 
 /// Base of the least-squares skeletal terms: subclasses only list residuals.
 class BoneLeastSquaresTerm : public EnergyTerm {
@@ -51,7 +51,8 @@ class BoneLeastSquaresTerm : public EnergyTerm {
   /// Residual blocks at q (appended to `out`). Public so tests can check the
   /// Jacobians against finite differences of r itself.
   virtual void residuals(const StepContext& ctx, const Configuration& q, std::vector<BoneResidual>& out) const = 0;
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  BodyBlocks blocks() const override { return BodyBlocks::Bones; }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 };
 
 }  // namespace sflsh

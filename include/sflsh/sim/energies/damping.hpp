@@ -16,7 +16,8 @@ class DampingTerm : public EnergyTerm {
   /// `beta` in seconds (≥ 0); K₀ from `elastic` at z = 0.
   DampingTerm(const Avatar& avatar, const ElasticTerm& elastic, double beta);
   std::string name() const override { return "damping"; }
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  BodyBlocks blocks() const override { return BodyBlocks::Soft; }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
  private:
   double beta_;

@@ -27,7 +27,8 @@ class ElasticTerm : public EnergyTerm {
   /// remainder keeps the barrier and saturation at large strains.
   explicit ElasticTerm(const Avatar& avatar, bool project_psd = true, bool exact_quadratic = true);
   std::string name() const override { return "elastic"; }
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  BodyBlocks blocks() const override { return BodyBlocks::Soft; }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
   /// Deformation gradient of sample k for reduced DoFs z.
   Mat3 deformation_gradient(int k, const VecX& z) const;

@@ -13,7 +13,7 @@ class GravityTerm : public EnergyTerm {
   /// Uses avatar.inertia; the gravity vector is ctx.gravity (m/s²).
   explicit GravityTerm(const Avatar& avatar);
   std::string name() const override { return "gravity"; }
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
  private:
   PosedPoints points_;

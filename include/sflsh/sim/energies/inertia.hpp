@@ -16,8 +16,9 @@ class InertiaTerm : public EnergyTerm {
   /// Uses avatar.inertia; sample density from the region of its tet.
   explicit InertiaTerm(const Avatar& avatar);
   std::string name() const override { return "inertia"; }
-  void begin_step(const StepContext& ctx) override;
-  double evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const override;
+  std::unique_ptr<TermCache> make_cache() const override;
+  void begin_step(const StepContext& ctx) const override;
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
   /// #S sample masses (kg).
   const VecX& masses() const { return mass_; }
@@ -26,7 +27,6 @@ class InertiaTerm : public EnergyTerm {
  private:
   PosedPoints points_;
   VecX mass_;
-  Points x_predicted_;  // #S by 3, world (m)
 };
 
 /// #S masses ρ(region of the sample's tet) · weight (kg) of a cubature.

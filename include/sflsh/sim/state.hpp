@@ -1,0 +1,65 @@
+#pragma once
+// The mutable half of the runtime (MuJoCo's mjData role): per body q_t and
+// q_{t−1}, the time, and the per-step caches of the model's terms; plus the
+// per-step inputs (motion targets per body, named world frames of obstacles
+// and tools). A step is a function of (Model, State, StepInputs) (step.hpp).
+// A State can be copied (the copy gets fresh caches: they are recomputed at
+// the start of every step) and saved/restored (state_file.hpp).
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/model.hpp"
+
+namespace sflsh {
+
+/// One body's state: q at time t and at t − h (velocity (q − q_prev)/h).
+struct BodyState {
+  Configuration q, q_prev;
+};
+
+/// What drives one body in a step: its target bones at t + h (24 world
+/// transforms; the prescribed bones when kinematic, tracking targets
+/// otherwise) and the target pose (tracking springs).
+struct BodyTargets {
+  std::vector<Isometry> bones;
+  BodyPose pose;
+};
+
+/// Inputs of one step.
+struct StepInputs {
+  std::vector<BodyTargets> bodies;            ///< one per model body
+  std::map<std::string, WorldFrame> frames;   ///< named world frames at t + h (world, not shifted)
+};
+
+/// Scratch of a step: the terms' caches and contexts (see header comment).
+struct StepWorkspace;
+
+class State {
+ public:
+  double time = 0;                 ///< s
+  std::vector<BodyState> bodies;   ///< one per model body
+
+  State();
+  ~State();
+  State(const State& other);
+  State& operator=(const State& other);
+  State(State&&) noexcept;
+  State& operator=(State&&) noexcept;
+
+  /// The step's scratch, created for `model` on first use.
+  StepWorkspace& workspace(const Model& model);
+
+ private:
+  std::unique_ptr<StepWorkspace> workspace_;
+};
+
+/// A state at rest for `model`: every bone G_i = I, z = 0, time 0.
+State rest_state(const Model& model);
+
+/// Throws unless `state` fits `model` (body count, 24 bones, z sizes, finite).
+void validate_state(const Model& model, const State& state);
+
+}  // namespace sflsh

@@ -1,0 +1,30 @@
+#pragma once
+// Checkpoints: a State saved to HDF5 and read back, so that a run can stop
+// and resume bit-identically (`sflsh simulate --checkpoint F` / `--resume F`).
+//
+// Layout (names fixed; SI units):
+//   /meta/format_version   1
+//   /meta/kind             "sflsh state"
+//   /state/time            s
+//   /state/bodies          (B,) body names, in model order
+//   /state/<i>/bones       (24, 12) q_t: per bone the row-major rotation (9) then the translation (3)
+//   /state/<i>/bones_prev  (24, 12) q_{t−1}
+//   /state/<i>/z, z_prev   (3K,)    reduced soft DoFs at t and t − h
+// Doubles are stored exactly (no float32), so a restored state equals the saved one.
+#include <string>
+
+#include "sflsh/sim/model.hpp"
+#include "sflsh/sim/state.hpp"
+
+namespace sflsh {
+
+inline constexpr int kStateFormatVersion = 1;
+
+/// Writes `state` of `model` to `path` (atomically: NAME.partial, then renamed).
+void write_state(const std::string& path, const Model& model, const State& state);
+
+/// Reads a state saved for a model like `model`: the body names, their count
+/// and each body's K must match (else one error naming the file and field).
+State read_state(const std::string& path, const Model& model);
+
+}  // namespace sflsh

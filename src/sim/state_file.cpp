@@ -1,0 +1,88 @@
+#include "sflsh/sim/state_file.hpp"
+
+#include <cmath>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+
+namespace sflsh {
+namespace {
+
+MatXr pack_bones(const std::vector<Isometry>& bones) {
+  MatXr m(bones.size(), 12);
+  for (size_t i = 0; i < bones.size(); ++i) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m(i, 3 * r + c) = bones[i].linear()(r, c);
+    for (int c = 0; c < 3; ++c) m(i, 9 + c) = bones[i].translation()(c);
+  }
+  return m;
+}
+
+std::vector<Isometry> unpack_bones(const MatXr& m) {
+  std::vector<Isometry> bones(m.rows(), Isometry::Identity());
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) bones[i].linear()(r, c) = m(i, 3 * r + c);
+    for (int c = 0; c < 3; ++c) bones[i].translation()(c) = m(i, 9 + c);
+  }
+  return bones;
+}
+
+}  // namespace
+
+void write_state(const std::string& path, const Model& model, const State& state) {
+  validate_state(model, state);
+  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
+  f.write_scalar("/meta/format_version", std::int64_t(kStateFormatVersion));
+  f.write_string("/meta/kind", "sflsh state");
+  f.write_scalar("/state/time", state.time);
+  std::vector<std::string> names;
+  for (const Model::Body& b : model.bodies()) names.push_back(b.name);
+  f.write_strings("/state/bodies", names);
+  for (size_t b = 0; b < state.bodies.size(); ++b) {
+    const std::string g = "/state/" + std::to_string(b) + "/";
+    const BodyState& s = state.bodies[b];
+    f.write_matrix(g + "bones", pack_bones(s.q.bones));
+    f.write_matrix(g + "bones_prev", pack_bones(s.q_prev.bones));
+    f.write_nd(g + "z", s.q.z.data(), {s.q.z.size()});
+    f.write_nd(g + "z_prev", s.q_prev.z.data(), {s.q_prev.z.size()});
+  }
+  f.commit();
+}
+
+State read_state(const std::string& path, const Model& model) {
+  io::Hdf5File f(path, io::Hdf5File::Mode::Read);
+  require(f.has("/meta/kind") && f.read_string("/meta/kind") == "sflsh state", path,
+          ": not an sflsh state file (/meta/kind is missing or not \"sflsh state\")");
+  const double version = f.read_scalar("/meta/format_version");
+  require(version == kStateFormatVersion, path, ": /meta/format_version is ", version, ", expected ",
+          kStateFormatVersion);
+  const std::vector<std::string> names = f.read_strings("/state/bodies");
+  require(names.size() == model.bodies().size(), path, ": /state/bodies has ", names.size(),
+          " bodies, the scene has ", model.bodies().size());
+  State s;
+  s.time = f.read_scalar("/state/time");
+  require(std::isfinite(s.time), path, ": /state/time is not finite");
+  for (size_t b = 0; b < names.size(); ++b) {
+    const Model::Body& body = model.bodies()[b];
+    require(names[b] == body.name, path, ": /state/bodies[", b, "] is '", names[b], "', the scene's body ", b,
+            " is '", body.name, "'");
+    const std::string g = "/state/" + std::to_string(b) + "/";
+    const std::int64_t r = body.avatar->num_reduced();
+    BodyState st;
+    st.q.bones = unpack_bones(f.read_matrix(g + "bones", 24, 12));
+    st.q_prev.bones = unpack_bones(f.read_matrix(g + "bones_prev", 24, 12));
+    const std::vector<double> z = f.read_nd(g + "z", {r}), zp = f.read_nd(g + "z_prev", {r});
+    st.q.z = Eigen::Map<const VecX>(z.data(), r);
+    st.q_prev.z = Eigen::Map<const VecX>(zp.data(), r);
+    s.bodies.push_back(std::move(st));
+  }
+  try {
+    validate_state(model, s);
+  } catch (const Error& e) {
+    fail(path, ": ", e.what());
+  }
+  return s;
+}
+
+}  // namespace sflsh
