@@ -39,7 +39,9 @@ void check_options(const MeshSdfBakeOptions& o, const std::string& what) {
   require(std::isfinite(o.band) && o.band >= 0, what, ": mesh SDF band must be >= 0 m, got ", o.band);
 }
 
-void check_closed(const Points& V, const Triangles& F, const std::string& what) {
+}  // namespace
+
+void require_closed_mesh(const Points& V, const Triangles& F, const std::string& what) {
   require(V.rows() > 0 && F.rows() > 0, what, ": the mesh is empty");
   const SurfaceReport r = check_surface(V, F, false);  // also rejects NaN and bad indices
   if (!r.is_closed || !r.is_manifold)
@@ -47,8 +49,6 @@ void check_closed(const Points& V, const Triangles& F, const std::string& what) 
          " boundary edges, ", r.num_nonmanifold_edges, " non-manifold edges, ", r.num_nonmanifold_vertices,
          " non-manifold vertices and ", r.num_degenerate_faces, " degenerate faces");
 }
-
-}  // namespace
 
 std::string MeshSdfBakeReport::describe() const {
   std::ostringstream o;
@@ -66,7 +66,7 @@ geometry::GridSdf bake_mesh_sdf(const Points& V, const Triangles& F, const MeshS
                                 const std::string& what, MeshSdfBakeReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   check_options(options, what);
-  check_closed(V, F, what);
+  require_closed_mesh(V, F, what);
 
   SurfaceMesh mesh;
   std::vector<SurfaceMesh::Vertex_index> vi(V.rows());
@@ -166,7 +166,7 @@ geometry::GridSdf load_or_bake_mesh_sdf(const std::string& mesh_path, double sca
   if (!cache_dir.empty()) {
     // Check the mesh before trusting (or filling) the cache.
     check_options(options, mesh_path);
-    check_closed(m.vertices, m.faces, mesh_path);
+    require_closed_mesh(m.vertices, m.faces, mesh_path);
     r.cache_path =
         (std::filesystem::path(cache_dir) / "mesh_sdf" / (mesh_sdf_cache_key(m.vertices, m.faces, options) + ".h5")).string();
     if (std::filesystem::exists(r.cache_path)) {

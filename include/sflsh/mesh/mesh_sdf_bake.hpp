@@ -42,6 +42,11 @@ struct MeshSdfBakeReport {
   std::string describe() const; ///< one line
 };
 
+/// Throws "<what>: a mesh SDF needs a closed manifold triangle mesh; this one
+/// has N boundary edges, ..." unless (V, F) is non-empty, finite, closed and
+/// manifold (mesh/surface_checks.hpp).
+void require_closed_mesh(const Points& V, const Triangles& F, const std::string& what);
+
 /// Bakes the closed mesh (V: #V by 3 m, F: #F by 3) into a grid covering its
 /// bounding box plus `padding`, in the mesh's own coordinates. `what` names
 /// the mesh in errors (e.g. its file). Throws one sflsh::Error naming `what`
