@@ -86,14 +86,18 @@ class SceneParser {
     return n.Scalar();
   }
 
-  double number(const YAML::Node& n, const std::string& key) const {
-    double v = 0;
-    if (!n.IsScalar()) error(n, key, "expected a number");
+  /// A scalar converted by yaml-cpp to T; `what` names the expected type ("a number").
+  template <class T>
+  T convert(const YAML::Node& n, const std::string& key, const char* what) const {
+    if (!n.IsScalar()) error(n, key, "expected ", what);
     try {
-      v = n.as<double>();
+      return n.as<T>();
     } catch (const YAML::Exception&) {
-      error(n, key, "expected a number, got '", n.Scalar(), "'");
+      error(n, key, "expected ", what, ", got '", n.Scalar(), "'");
     }
+  }
+  double number(const YAML::Node& n, const std::string& key) const {
+    const double v = convert<double>(n, key, "a number");
     if (!std::isfinite(v)) error(n, key, "must be finite, got ", n.Scalar());
     return v;
   }
@@ -108,24 +112,11 @@ class SceneParser {
     return v;
   }
   int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
-    int v = 0;
-    if (!n.IsScalar()) error(n, key, "expected an integer");
-    try {
-      v = n.as<int>();
-    } catch (const YAML::Exception&) {
-      error(n, key, "expected an integer, got '", n.Scalar(), "'");
-    }
+    const int v = convert<int>(n, key, "an integer");
     if (v < lo || v > hi) error(n, key, "must be in [", lo, ", ", hi, "], got ", v);
     return v;
   }
-  bool boolean(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) error(n, key, "expected true or false");
-    try {
-      return n.as<bool>();
-    } catch (const YAML::Exception&) {
-      error(n, key, "expected true or false, got '", n.Scalar(), "'");
-    }
-  }
+  bool boolean(const YAML::Node& n, const std::string& key) const { return convert<bool>(n, key, "true or false"); }
   /// A list of exactly `count` numbers.
   std::vector<double> numbers(const YAML::Node& n, const std::string& key, std::size_t count) const {
     if (!n.IsSequence() || n.size() != count) error(n, key, "expected a list of ", count, " numbers");

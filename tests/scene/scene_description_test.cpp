@@ -182,27 +182,32 @@ objects:
 }
 
 TEST(SceneDescription, NegativeAndNonFiniteValues) {
+  // Lines 1-6 of each scene; the object's keys follow from line 7.
   const std::string head = "bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1}\nobjects:\n  - name: o\n";
-  expect_scene_error(head + "    shape: {type: sphere, radius: 0.1}\n    kind: dynamic\n    mass: -2\n",
-                     {"scene.yaml:9:", "objects[0].mass", "must be > 0, got -2"});
-  expect_scene_error(head + "    shape: {type: capsule, radius: -0.1, length: 0.3}\n",
-                     {"scene.yaml:7:", "objects[0].shape.radius", "must be > 0, got -0.1"});
-  expect_scene_error(head + "    shape: {type: box, size: [0.1, -0.2, 0.3]}\n    kind: dynamic\n    density: 500\n",
-                     {"scene.yaml:7:", "objects[0].shape.size[1]", "must be > 0"});
-  expect_scene_error(head + "    shape: {type: cylinder, radius: 0.1, length: 0.2}\n    kind: dynamic\n    density: -5\n",
-                     {"scene.yaml:9:", "objects[0].density", "must be > 0, got -5"});
-  expect_scene_error(head + "    shape: {type: sphere, radius: .nan}\n",
-                     {"scene.yaml:7:", "objects[0].shape.radius", "must be finite"});
-  expect_scene_error(head + "    shape: {type: sphere, radius: 0.1}\n    position: [0, .inf, 0]\n",
-                     {"scene.yaml:8:", "objects[0].position[1]", "must be finite"});
-  expect_scene_error(head + "    shape: {type: sphere, radius: 0.1}\n    orientation: [0, 0, 90, 0]\n",
-                     {"scene.yaml:8:", "objects[0].orientation", "unit quaternion"});
-  expect_scene_error(head + "    shape: {type: plane}\n    kind: dynamic\n    mass: 1\n",
-                     {"scene.yaml:8:", "objects[0].kind", "plane cannot be dynamic"});
-  expect_scene_error(head +
-                         "    shape: {type: sphere, radius: 0.1}\n    kind: kinematic\n    keyframes:\n"
-                         "      - {time: 1, position: [0, 0, 0]}\n      - {time: 0.5, position: [0, 0, 1]}\n",
-                     {"scene.yaml:11:", "objects[0].keyframes[1].time", "must increase"});
+  struct Case {
+    std::string object, line, key, message;
+  };
+  const std::vector<Case> cases = {
+      {"    shape: {type: sphere, radius: 0.1}\n    kind: dynamic\n    mass: -2\n",
+       "scene.yaml:9:", "objects[0].mass", "must be > 0, got -2"},
+      {"    shape: {type: capsule, radius: -0.1, length: 0.3}\n",
+       "scene.yaml:7:", "objects[0].shape.radius", "must be > 0, got -0.1"},
+      {"    shape: {type: box, size: [0.1, -0.2, 0.3]}\n    kind: dynamic\n    density: 500\n",
+       "scene.yaml:7:", "objects[0].shape.size[1]", "must be > 0"},
+      {"    shape: {type: cylinder, radius: 0.1, length: 0.2}\n    kind: dynamic\n    density: -5\n",
+       "scene.yaml:9:", "objects[0].density", "must be > 0, got -5"},
+      {"    shape: {type: sphere, radius: .nan}\n", "scene.yaml:7:", "objects[0].shape.radius", "must be finite"},
+      {"    shape: {type: sphere, radius: 0.1}\n    position: [0, .inf, 0]\n",
+       "scene.yaml:8:", "objects[0].position[1]", "must be finite"},
+      {"    shape: {type: sphere, radius: 0.1}\n    orientation: [0, 0, 90, 0]\n",
+       "scene.yaml:8:", "objects[0].orientation", "unit quaternion"},
+      {"    shape: {type: plane}\n    kind: dynamic\n    mass: 1\n",
+       "scene.yaml:8:", "objects[0].kind", "plane cannot be dynamic"},
+      {"    shape: {type: sphere, radius: 0.1}\n    kind: kinematic\n    keyframes:\n"
+       "      - {time: 1, position: [0, 0, 0]}\n      - {time: 0.5, position: [0, 0, 1]}\n",
+       "scene.yaml:11:", "objects[0].keyframes[1].time", "must increase"},
+  };
+  for (const Case& c : cases) expect_scene_error(head + c.object, {c.line, c.key, c.message});
   expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\ncontact: {stiffness: {body_body: -1}}\nsolver: {seconds: 1}\n",
                      {"scene.yaml:4:", "contact.stiffness.body_body", ">= 0"});
   expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\n", {"scene.yaml:1:", "solver.seconds", "no body has a motion"});
