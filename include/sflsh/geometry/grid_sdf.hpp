@@ -39,7 +39,7 @@ class GridSdf : public Sdf {
   double spacing() const { return h_; }
   const Eigen::Vector3i& dims() const { return dims_; }
   const std::vector<double>& values() const { return values_; }
-  /// φ at node (i, j, k) (no bounds check beyond an assertion).
+  /// φ at node (i, j, k) (indices are not checked).
   double node_value(int i, int j, int k) const { return values_[index(i, j, k)]; }
   /// Position of node (i, j, k) (m, local frame).
   Vec3 node_position(int i, int j, int k) const { return origin_ + h_ * Vec3(i, j, k); }
