@@ -1,0 +1,217 @@
+#pragma once
+// A scene file (`sflsh simulate scene.yaml`, issue 10): bodies (avatars),
+// rigid objects, contact, solver and outputs, as plain data. Nothing here
+// builds simulation objects; the runtime turns a SceneDescription into its
+// model and state.
+//
+// Top-level keys follow DESIGN.md §5b (bodies, objects, contact, solver,
+// output; `tools` is not read yet). Coordinates are the avatar's (SMPL) frame,
+// Y up: at rest the pelvis is near y = -0.22 m and the soles near y = -1.2 m.
+//
+// Example (every key shown; defaults in the comments, "required" where there is none):
+//
+//   solver:
+//     dt: 1/60                  # s, "N/D" or a number in (0, 0.1]; default 1/60
+//     seconds: 3                # simulated time (s, >= 0); default 0 = the longest body
+//                               # motion (then some body needs a motion)
+//     newton_iters: 1           # Newton iterations per step, 1..100; default 1
+//     line_search: false        # backtracking line search; default false
+//     gravity: [0, -9.81, 0]    # m/s^2, world, Y up; default [0, -9.81, 0]
+//     damping: 0                # stiffness-proportional soft-tissue damping (s, >= 0); default 0
+//   output:                     # paths relative to the working folder (like the CLI flags)
+//     out: result.h5            # result file; default result.h5
+//     export: result.glb        # optional: .pc2, .glb, or frames_%04d.obj/.ply/.glb
+//     render: result.png        # optional: PNG strip
+//     render_frames: 6          # frames in the strip (>= 1); default 6
+//     fps: 30                   # output frames per simulated second (> 0); default 30
+//   contact:
+//     stiffness:                # penalty ½k·d² per contact sample (N/m, >= 0)
+//       body_object: 2.0e4      # skin samples against rigid objects; default 2e4
+//       body_body: 1.0e4        # bone capsules of different bodies; default 1e4
+//       self: 5.0e3             # non-adjacent capsules of one body; default 5e3
+//     self_contact: false       # default false
+//     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
+//     pairs: all                # default all: every body-object and body-body pair;
+//                               # or a list of name pairs: [[alice, floor], [alice, bob]]
+//   bodies:                     # required, at least one
+//     - name: alice             # required; names are unique across bodies and objects
+//       avatar: avatar.h5       # required; relative to this file's folder
+//                               # (make it with `sflsh precompute --out avatar.h5`)
+//       motion: builtin:walk    # none | builtin:NAME | a motion file (relative to this
+//                               # file's folder: .npz, .bvh, .fbx, ...); default none
+//       placement:              # where the motion is played in the world
+//         offset: [0, 0, 0]     # m; default [0, 0, 0]
+//         heading_deg: 90       # rotation about +Y, degrees; default 0
+//       bones: dynamic          # dynamic | kinematic; default dynamic
+//       material: soft.yaml     # optional material file (relative to this file's folder)
+//       velocity: [0, 0, 0]     # m/s, initial linear velocity; default [0, 0, 0]
+//   objects:                    # optional
+//     - name: floor             # required
+//       shape: {type: plane, normal: [0, 1, 0]}   # required; see below
+//       kind: static            # static | kinematic | dynamic; default static
+//       position: [0, 0, 0]     # m (static, dynamic); default [0, 0, 0]
+//       orientation: [1, 0, 0, 0]  # unit quaternion w, x, y, z (static, dynamic); default identity
+//     - name: ball
+//       shape: {type: sphere, radius: 0.11}
+//       kind: dynamic
+//       density: 80             # kg/m^3 (> 0), or mass: 0.45 (kg, > 0); exactly one
+//       position: [0, 1.1, 0.6]
+//       velocity: [0, 0, -4]    # m/s; default [0, 0, 0]
+//       angular_velocity: [0, 0, 0]  # rad/s, world; default [0, 0, 0]
+//     - name: press
+//       shape: {type: box, size: [0.3, 0.05, 0.3]}
+//       kind: kinematic         # pose from keyframes (linear position, slerped rotation)
+//       keyframes:              # required, times >= 0 strictly increasing
+//         - {time: 0, position: [0, 1.3, 0.3], orientation: [1, 0, 0, 0]}
+//         - {time: 2, position: [0, 1.1, 0.3]}   # orientation defaults to identity
+//
+// Shapes (local frame; axes of symmetry along local +Y; lengths in m, > 0):
+//   plane    {normal: [0, 1, 0]}               half-space below the plane through the
+//                                               object's position (a plane cannot be dynamic)
+//   sphere   {radius}
+//   box      {size: [x, y, z]}                  full edge lengths
+//   capsule  {radius, length}                   length: between the cap centres (>= 0)
+//   cylinder {radius, length}                   capped, full height
+//   mesh     {file, scale: 1, voxel_size: 0.005, padding: 0.02, band: 0}
+//            a closed triangle mesh (OBJ/STL/PLY/... through assimp; relative to this
+//            file's folder) times `scale`, baked into a grid SDF (mesh/mesh_sdf_bake.hpp)
+//
+// Errors are one line "FILE:LINE: KEY.PATH: what was expected", e.g.
+//   scene.yaml:14: objects[2].shape.radius: must be > 0, got -0.1
+// for malformed YAML, unknown keys, missing required keys, wrong types,
+// non-finite numbers, out-of-range values (negative mass, radius, density,
+// ...), duplicate names, pairs naming an unknown body/object, and avatar,
+// motion, material or mesh files that do not exist. Whether a mesh is closed
+// is checked by validate_scene_files (it reads the meshes) and again when a
+// mesh is baked.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sflsh/core/types.hpp"
+
+namespace sflsh {
+
+/// One avatar in the scene.
+struct BodyDescription {
+  std::string name;
+  std::string avatar;              ///< avatar file (absolute after reading)
+  std::string motion = "none";     ///< "none", "builtin:NAME" or a file (absolute after reading)
+  Vec3 offset = Vec3::Zero();      ///< placement: m, world offset
+  double heading_deg = 0;          ///< placement: rotation about +Y, degrees
+  bool bones_dynamic = true;       ///< bones: dynamic (true) | kinematic
+  std::string material;            ///< material override file (absolute), "" = none
+  Vec3 velocity = Vec3::Zero();    ///< m/s, initial linear velocity
+};
+
+enum class ShapeType { Plane, Sphere, Box, Capsule, Cylinder, Mesh };
+/// "plane", "sphere", "box", "capsule", "cylinder", "mesh".
+const char* shape_type_name(ShapeType type);
+
+/// A rigid object's shape in its local frame (only the fields of its type are used).
+struct ShapeDescription {
+  ShapeType type = ShapeType::Sphere;
+  Vec3 normal = Vec3::UnitY();         ///< plane: outward normal (unit)
+  double radius = 0;                   ///< sphere, capsule, cylinder (m)
+  Vec3 size = Vec3::Zero();            ///< box: full edge lengths (m)
+  double length = 0;                   ///< capsule: between cap centres; cylinder: height (m)
+  std::string mesh_file;               ///< mesh: file (absolute after reading)
+  double mesh_scale = 1;               ///< mesh: coordinate factor (0.001 for mm files)
+  double voxel_size = 0.005;           ///< mesh: grid SDF spacing (m)
+  double padding = 0.02;               ///< mesh: grid room around the mesh (m)
+  double band = 0;                     ///< mesh: exact band (m), 0 = full grid
+  /// Where the shape was read ("scene.yaml:12: objects[2].shape"), for later
+  /// errors (validate_scene_files, baking); not written back.
+  std::string location;
+};
+
+enum class ObjectKind { Static, Kinematic, Dynamic };
+/// "static", "kinematic", "dynamic".
+const char* object_kind_name(ObjectKind kind);
+
+/// A pose of a kinematic object at a time.
+struct Keyframe {
+  double time = 0;                                         ///< s
+  Vec3 position = Vec3::Zero();                            ///< m, world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< unit, local to world
+};
+
+struct RigidObjectDescription {
+  std::string name;
+  ShapeDescription shape;
+  ObjectKind kind = ObjectKind::Static;
+  /// Static and dynamic: the (initial) pose. Kinematic: the first keyframe's.
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  std::vector<Keyframe> keyframes;       ///< kinematic only, times strictly increasing
+  double density = 0;                    ///< dynamic: kg/m³, or 0 when `mass` is given
+  double mass = 0;                       ///< dynamic: kg, or 0 when `density` is given
+  Vec3 velocity = Vec3::Zero();          ///< dynamic: m/s
+  Vec3 angular_velocity = Vec3::Zero();  ///< dynamic: rad/s, world axes
+};
+
+struct ContactDescription {
+  double body_object_stiffness = 2.0e4;  ///< N/m per skin sample
+  double body_body_stiffness = 1.0e4;    ///< N/m per capsule pair
+  double self_stiffness = 5.0e3;         ///< N/m per capsule pair of one body
+  bool self_contact = false;
+  double sample_spacing = 0;             ///< m; 0 = every skin vertex
+  /// true: every body–object and body–body pair collides; false: only `pairs`.
+  bool all_pairs = true;
+  /// Colliding pairs by name (each has a body; object–object contact is not modelled).
+  std::vector<std::pair<std::string, std::string>> pairs;
+};
+
+struct SolverDescription {
+  double dt = 1.0 / 60.0;               ///< s
+  double seconds = 0;                   ///< s; 0 = the longest body motion
+  int newton_iterations = 1;
+  bool line_search = false;
+  Vec3 gravity = Vec3(0, -9.81, 0);     ///< m/s²
+  double damping = 0;                   ///< s
+};
+
+struct OutputDescription {
+  std::string out = "result.h5";
+  std::string export_path;              ///< "" = none
+  std::string render;                   ///< "" = none
+  int render_frames = 6;
+  double fps = 30;
+};
+
+struct SceneDescription {
+  std::string path;                     ///< the file it was read from ("" if built in code)
+  std::vector<BodyDescription> bodies;
+  std::vector<RigidObjectDescription> objects;
+  ContactDescription contact;
+  SolverDescription solver;
+  OutputDescription output;
+
+  /// Index of the body / object named `name`, or -1.
+  int body_index(const std::string& name) const;
+  int object_index(const std::string& name) const;
+  /// Whether bodies/objects `a` and `b` (names) collide under `contact`
+  /// (all_pairs or listed in either order; object–object never).
+  bool collides(const std::string& a, const std::string& b) const;
+};
+
+/// Reads and checks a scene file; relative input paths (avatar, motion,
+/// material, mesh) are resolved against the file's folder and stored
+/// absolute, output paths are kept as written. Throws one sflsh::Error
+/// "FILE:LINE: KEY.PATH: message" on any bad input listed above.
+SceneDescription read_scene_description(const std::string& path);
+
+/// The scene as YAML text in the format above (the keys of each object's
+/// kind, numbers as the shortest decimals that read back to the same values,
+/// input paths absolute).
+std::string scene_description_yaml(const SceneDescription& scene);
+
+/// Writes scene_description_yaml(scene) to `path` (atomic).
+void write_scene_description(const SceneDescription& scene, const std::string& path);
+
+/// Checks what reading does not: every mesh object's file is a closed
+/// manifold triangle mesh (io::read_mesh + check_surface). Throws
+/// "FILE:LINE: objects[i].shape: MESHFILE: ..." otherwise.
+void validate_scene_files(const SceneDescription& scene);
+
+}  // namespace sflsh
