@@ -8,7 +8,7 @@
 
 #include "command.hpp"
 #include "sflsh/core/error.hpp"
-#include "sflsh/scene/benchmark.hpp"
+#include "sflsh/bench/benchmark.hpp"
 
 namespace sflsh::cli {
 namespace {

@@ -19,7 +19,7 @@
 #include "sflsh/io/npz.hpp"
 #include "sflsh/io/png_image.hpp"
 #include "sflsh/io/render.hpp"
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 
 namespace sflsh::cli {
 namespace {

@@ -8,7 +8,7 @@
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/asset/avatar_summary.hpp"
-#include "sflsh/asset/precompute.hpp"
+#include "sflsh/precompute/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"

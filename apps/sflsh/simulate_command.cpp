@@ -6,14 +6,15 @@
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
-#include "sflsh/asset/precompute.hpp"
+#include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/motion/load_motion.hpp"
-#include "sflsh/scene/file_betas_avatar.hpp"
+#include "sflsh/precompute/file_betas_avatar.hpp"
 #include "sflsh/scene/material_file.hpp"
 #include "sflsh/scene/result_export.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 
 namespace sflsh::cli {

@@ -6,7 +6,7 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/time_step.hpp"
-#include "sflsh/scene/stress_run.hpp"
+#include "sflsh/bench/stress_run.hpp"
 
 namespace sflsh::cli {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "basis/cholmod_llt.hpp"
 #include "sflsh/asset/avatar.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
@@ -318,8 +318,8 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
 
   Timer timer;
   // Q = L M⁻¹ L with lumped M (Jacobson et al. 2011, eq. 5).
-  const SpMat L = stiffness_laplacian(mesh);
-  const VecX m = lumped_mass(mesh);
+  const SpMat L = fem::stiffness_laplacian(mesh);
+  const VecX m = fem::lumped_mass(mesh);
   const SpMat Q = L * m.cwiseInverse().asDiagonal() * L;
 
   std::vector<int> free_nodes;
@@ -343,7 +343,7 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
 
   // Local domains: distance of every free node to the fixed nodes that carry
   // a nonzero value in the column; start radius from the volume per column.
-  const double volume = lumped_mass(mesh).sum();
+  const double volume = fem::lumped_mass(mesh).sum();
   const double radius0 = options.initial_radius_factor * std::cbrt(volume / std::max(C, 1));
   const double t_setup = timer.seconds();
 

@@ -3,7 +3,7 @@
 #include <map>
 #include <vector>
 
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::basis {
@@ -15,7 +15,7 @@ Cubature data_oblivious_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<
           " by ", K);
   require(dominant_bone.size() == 0 || dominant_bone.size() == n, "cubature: dominant_bone has ",
           dominant_bone.size(), " entries, expected #N = ", n, " or none");
-  const VecX vol = tet_volumes(mesh);
+  const VecX vol = fem::tet_volumes(mesh);
 
   // Largest incident tet and local vertex index for every handle node.
   std::vector<int> handle_of(n, -1);
@@ -33,7 +33,7 @@ Cubature data_oblivious_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<
 
   // Integrals of the handle weights and of the bone complement per region.
   const MatX Wd = MatX(W);
-  const Eigen::RowVectorXd c_handles = integrate_linear(mesh, Wd);
+  const Eigen::RowVectorXd c_handles = fem::integrate_linear(mesh, Wd);
   VecX bone = VecX::Ones(n) - Wd.rowwise().sum();
   std::map<int, int> region_col;  // bone index → column
   for (int i = 0; i < n; ++i) region_col.emplace(dominant_bone.size() ? dominant_bone(i) : 0, 0);
@@ -49,7 +49,7 @@ Cubature data_oblivious_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<
     }
     bone_fields(i, region_col[b]) = bone(i);
   }
-  const Eigen::RowVectorXd c_bones = integrate_linear(mesh, bone_fields);
+  const Eigen::RowVectorXd c_bones = fem::integrate_linear(mesh, bone_fields);
 
   std::vector<int> elems;
   std::vector<Eigen::RowVector4d> barys;
@@ -95,7 +95,7 @@ Cubature stratified_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<doub
   require(W.rows() == mesh.num_nodes(), "stratified_cubature: W has ", W.rows(), " rows, mesh has ", mesh.num_nodes(),
           " nodes");
   const int K = int(W.cols());
-  const VecX vol = tet_volumes(mesh);
+  const VecX vol = fem::tet_volumes(mesh);
   // Node-wise weights of the K handles plus the bone complement.
   MatX Wd = MatX(W);
   // Cell label per tet: argmax of the tet-mean weights; bone cells by bone index.
@@ -189,7 +189,7 @@ CubatureErrors cubature_errors(const TetMesh& mesh, const Cubature& cubature, co
   require(tet_density.size() == 0 || tet_density.size() == T, "cubature errors: tet_density has ",
           tet_density.size(), " entries, expected #T = ", T, " or none");
   const VecX rho = tet_density.size() ? tet_density : VecX::Constant(T, 1000.0);
-  const VecX vol = tet_volumes(mesh);
+  const VecX vol = fem::tet_volumes(mesh);
   Vec3 c = Vec3::Zero();
   std::vector<Vec3> g(T);
   for (int e = 0; e < T; ++e) {

@@ -4,7 +4,7 @@
 #include <utility>
 #include <vector>
 
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::basis {
@@ -27,14 +27,14 @@ Cubature stiffness_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatri
   auto modulus = [&](int t) { return tet_modulus.size() ? tet_modulus[t] : 1.0; };
 
   // Full tensor T_{kl} (k ≤ l) over all tets.
-  const VecX vol = tet_volumes(mesh);
-  const std::vector<TetGradient> grads = tet_gradients(mesh);
+  const VecX vol = fem::tet_volumes(mesh);
+  const std::vector<fem::TetGradient> grads = fem::tet_gradients(mesh);
   std::vector<Mat3> T(size_t(K) * K, Mat3::Zero());
   std::vector<char> used(size_t(K) * K, 0);
   double volume = 0;
   for (int t = 0; t < mesh.num_elements(); ++t) {
     volume += vol[t];
-    const HandleGradients d = handle_gradients(mesh, grads[t], W, node_role, t);
+    const HandleGradients d = fem::handle_gradients(mesh, grads[t], W, node_role, t);
     const double s = vol[t] * modulus(t);
     for (size_t i = 0; i < d.size(); ++i)
       for (size_t j = i; j < d.size(); ++j) {
@@ -66,7 +66,7 @@ Cubature stiffness_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatri
   b[rows] = kVolumeRowWeight;
   for (int s = 0; s < n; ++s) {
     const int t = candidates.elements[s];
-    const HandleGradients d = handle_gradients(mesh, grads[t], W, node_role, t);
+    const HandleGradients d = fem::handle_gradients(mesh, grads[t], W, node_role, t);
     for (size_t i = 0; i < d.size(); ++i)
       for (size_t j = i; j < d.size(); ++j) {
         const size_t p = size_t(d[i].first) * K + d[j].first;

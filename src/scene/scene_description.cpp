@@ -14,7 +14,7 @@
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/mesh_export.hpp"
-#include "sflsh/mesh/mesh_sdf_bake.hpp"
+#include "sflsh/meshing/mesh_sdf_bake.hpp"
 #include "sflsh/motion/builtin_motions.hpp"
 
 namespace sflsh {

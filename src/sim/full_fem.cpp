@@ -86,7 +86,7 @@ FullFem::FullFem(std::shared_ptr<const Avatar> avatar, FullFemOptions options)
     }
   require(!free_node_.empty(), "FullFem: the avatar has no Simulated nodes");
 
-  grads_ = basis::tet_gradients(a.tet);
+  grads_ = fem::tet_gradients(a.tet);
   volume_.resize(T);
   mass_ = VecX::Zero(N);
   for (int t = 0; t < T; ++t) {

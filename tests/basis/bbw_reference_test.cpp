@@ -10,7 +10,7 @@
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/handle_placement.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 namespace sflsh::basis {
 namespace {
@@ -84,8 +84,8 @@ TEST(BoundedBiharmonicReference, FastPathMatchesDenseReference) {
   EXPECT_LT(rep.mean_factorizations, rep.mean_iterations) << "the bordered solves were never used";
 
   // Reference: dense Q_ff = (L M⁻¹ L)_ff, q = Q_fb x_b.
-  const MatX L = MatX(stiffness_laplacian(mesh));
-  const MatX Q = L * lumped_mass(mesh).cwiseInverse().asDiagonal() * L;
+  const MatX L = MatX(fem::stiffness_laplacian(mesh));
+  const MatX Q = L * fem::lumped_mass(mesh).cwiseInverse().asDiagonal() * L;
   std::vector<int> free_nodes;
   for (int i = 0; i < n; ++i)
     if (!is_fixed[size_t(i)]) free_nodes.push_back(i);

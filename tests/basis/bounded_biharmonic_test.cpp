@@ -7,7 +7,7 @@
 #include "box_mesh.hpp"
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/basis/handle_placement.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::basis {
@@ -105,7 +105,7 @@ TEST(BoundedBiharmonic, BoundsInterpolationAndPartitionOfUnity) {
   ASSERT_GE(rep.kkt_history.size(), 2u);
   EXPECT_GT(rep.kkt_history.front(), 1e-4);  // the first local solve violates the bounds
   // Weights are smooth bumps: each has mass and is sparse-ish.
-  const Eigen::RowVectorXd integrals = integrate_linear(s.mesh, Wd);
+  const Eigen::RowVectorXd integrals = fem::integrate_linear(s.mesh, Wd);
   EXPECT_GT(integrals.minCoeff(), 0.0);
   EXPECT_LT(W.nonZeros(), Wd.size());
 }
@@ -123,8 +123,8 @@ TEST(BoundedBiharmonic, NoFeasiblePerturbationLowersTheEnergy) {
   MatX bc = MatX::Zero(b.size(), 1);
   bc(0, 0) = 1.0;  // handle 0's weight
   const MatX w = bounded_biharmonic_qp(s.mesh, b, bc, quiet());
-  const auto L = stiffness_laplacian(s.mesh);
-  const VecX minv = lumped_mass(s.mesh).cwiseInverse();
+  const auto L = fem::stiffness_laplacian(s.mesh);
+  const VecX minv = fem::lumped_mass(s.mesh).cwiseInverse();
   auto energy = [&](const VecX& x) {
     const VecX Lx = L * x;
     return 0.5 * Lx.dot(minv.asDiagonal() * Lx);

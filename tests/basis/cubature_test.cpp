@@ -5,7 +5,7 @@
 #include "box_mesh.hpp"
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/handle_placement.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 namespace sflsh::basis {
 namespace {
@@ -37,7 +37,7 @@ TEST(Cubature, DataObliviousIsExactOnConstantsAndSitsAtHandles) {
   const Points x = cubature_points(b.mesh, c);
   for (int k = 0; k < 12; ++k) {
     EXPECT_LT((x.row(k) - b.handles.positions.row(k)).norm(), 1e-15);
-    EXPECT_NEAR(c.weights(k), integrate_linear(b.mesh, MatX(b.W).col(k))(0), 1e-15);
+    EXPECT_NEAR(c.weights(k), fem::integrate_linear(b.mesh, MatX(b.W).col(k))(0), 1e-15);
   }
   // Bone samples lie in their own region.
   EXPECT_LT(x(12, 0), 0.15);

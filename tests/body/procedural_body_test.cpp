@@ -8,7 +8,7 @@
 
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/core/error.hpp"
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 
 namespace sflsh {
 namespace {

@@ -7,6 +7,7 @@
 
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "test_support.hpp"
 

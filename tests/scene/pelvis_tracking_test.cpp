@@ -8,6 +8,7 @@
 
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/motion/builtin_motions.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "sim/skeleton_fixture.hpp"
 #include "sim/synthetic_avatar.hpp"

@@ -4,6 +4,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "test_support.hpp"
 

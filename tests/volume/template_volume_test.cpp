@@ -10,7 +10,7 @@
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
-#include "sflsh/mesh/tetrahedralize.hpp"
+#include "sflsh/meshing/tetrahedralize.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/correspondence.hpp"
 #include "sflsh/volume/shape_volume.hpp"

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "sflsh/asset/avatar.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/sim/configuration.hpp"
 #include "sflsh/sim/material.hpp"
 #include "sflsh/sim/posed_points.hpp"
@@ -79,7 +79,7 @@ class FullFem {
   std::vector<int> node_free_;       // node → free index or −1
   VecX mass_;                        // #N lumped masses (kg)
   VecX volume_;                      // #T
-  std::vector<basis::TetGradient> grads_;  // #T shape-function gradients
+  std::vector<fem::TetGradient> grads_;  // #T shape-function gradients
   std::vector<MaterialPoint> materials_;
   bool project_hessian_ = false;  // element Hessians: exact, or PSD majorizers  // #T, region material in the tet's frame
   std::vector<int> tet_slot_;        // #T·144: value index in the lower CSC or −1

@@ -11,7 +11,7 @@
 #include "sflsh/core/types.hpp"
 #include "sflsh/mesh/tet_mesh.hpp"
 #include "sflsh/mesh/sliver_repair.hpp"
-#include "sflsh/mesh/tetrahedralize.hpp"
+#include "sflsh/meshing/tetrahedralize.hpp"
 #include "sflsh/volume/correspondence.hpp"
 #include "sflsh/volume/skeleton_segments.hpp"
 

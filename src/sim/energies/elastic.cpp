@@ -4,7 +4,7 @@
 #include <limits>
 #include <vector>
 
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh {
@@ -62,12 +62,12 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   require(a.W.rows() == a.tet.num_nodes() && a.W.cols() == a.num_handles(), "ElasticTerm: W is ", a.W.rows(),
           " by ", a.W.cols(), ", expected #N = ", a.tet.num_nodes(), " by #K = ", a.num_handles());
   weight_ = cub.weights;
-  const std::vector<basis::TetGradient> grads = basis::tet_gradients(a.tet);
+  const std::vector<fem::TetGradient> grads = fem::tet_gradients(a.tet);
   for (int k = 0; k < cub.size(); ++k) {
     const int t = cub.elements[k];
     require(t >= 0 && t < a.tet.num_elements(), "ElasticTerm: sample ", k, " has tet ", t, ", expected in [0, ",
             a.tet.num_elements(), ")");
-    for (const auto& [h, v] : basis::handle_gradients(a.tet, grads[t], a.W, a.node_role, t)) {
+    for (const auto& [h, v] : fem::handle_gradients(a.tet, grads[t], a.W, a.node_role, t)) {
       handle_.push_back(h);
       d_.push_back(v);
     }
@@ -78,14 +78,14 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   if (!exact_quadratic_) return;
   // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
   K_ = MatX::Zero(num_reduced_, num_reduced_);
-  const VecX volume = basis::tet_volumes(a.tet);
+  const VecX volume = fem::tet_volumes(a.tet);
   std::vector<Eigen::Matrix<double, 3, 9>> T;
   std::vector<int> handle;
   std::vector<Vec3> d;
   for (int t = 0; t < a.tet.num_elements(); ++t) {
     handle.clear();
     d.clear();
-    for (const auto& [h, v] : basis::handle_gradients(a.tet, grads[t], a.W, a.node_role, t))
+    for (const auto& [h, v] : fem::handle_gradients(a.tet, grads[t], a.W, a.node_role, t))
       handle.push_back(h), d.push_back(v);
     if (handle.empty()) continue;
     const Mat9 H2 = volume[t] * linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));

@@ -1,11 +1,11 @@
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 #include <algorithm>
 #include <vector>
 
 #include "sflsh/core/error.hpp"
 
-namespace sflsh::basis {
+namespace sflsh::fem {
 namespace {
 
 Mat3 edge_matrix(const TetMesh& mesh, int e) {
@@ -117,4 +117,4 @@ Eigen::RowVectorXd integrate_linear(const TetMesh& mesh, const MatX& f) {
   return sum;
 }
 
-}  // namespace sflsh::basis
+}  // namespace sflsh::fem

@@ -1,4 +1,4 @@
-#include "sflsh/mesh/mesh_sdf_bake.hpp"
+#include "sflsh/meshing/mesh_sdf_bake.hpp"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -16,7 +16,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/fnv_hash.hpp"
 #include "sflsh/io/mesh_export.hpp"
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 
 namespace sflsh {
 namespace {

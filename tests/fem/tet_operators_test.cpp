@@ -1,11 +1,11 @@
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 #include <gtest/gtest.h>
 
-#include "box_mesh.hpp"
+#include "basis/box_mesh.hpp"
 #include "sflsh/core/error.hpp"
 
-namespace sflsh::basis {
+namespace sflsh::fem {
 namespace {
 
 TEST(TetOperators, BoxMeshIsPositiveAndFillsTheBox) {
@@ -74,4 +74,4 @@ TEST(TetOperators, RejectsInvertedTetsAndBadIndices) {
 }
 
 }  // namespace
-}  // namespace sflsh::basis
+}  // namespace sflsh::fem

@@ -1,7 +1,7 @@
 // Surface checks: edge/vertex manifoldness, orientation, components, Euler
 // characteristic, volume, and self-intersection through CGAL (kept inside this
 // file so that no public header pulls CGAL in).
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "sflsh/mesh/tetrahedralize.hpp"
+#include "sflsh/meshing/tetrahedralize.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>

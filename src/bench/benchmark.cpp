@@ -1,4 +1,4 @@
-#include "sflsh/scene/benchmark.hpp"
+#include "sflsh/bench/benchmark.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <functional>
 
-#include "sflsh/mesh/tetrahedralize.hpp"
+#include "sflsh/meshing/tetrahedralize.hpp"
 
 namespace sflsh {
 namespace {

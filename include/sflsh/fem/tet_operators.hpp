@@ -11,7 +11,7 @@
 #include "sflsh/core/types.hpp"
 #include "sflsh/mesh/tet_mesh.hpp"
 
-namespace sflsh::basis {
+namespace sflsh::fem {
 
 /// Shape-function gradients of one tet: row a is ∇φ_a (1/m), a = 0..3.
 using TetGradient = Eigen::Matrix<double, 4, 3>;
@@ -49,4 +49,4 @@ Eigen::SparseMatrix<double> consistent_mass(const TetMesh& mesh);
 /// `f` (#N by C): 1 by C, units of f times m^3. Σ_e V_e · mean of f at e's nodes.
 Eigen::RowVectorXd integrate_linear(const TetMesh& mesh, const MatX& f);
 
-}  // namespace sflsh::basis
+}  // namespace sflsh::fem

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "sflsh/asset/precompute.hpp"
+#include "sflsh/precompute/precompute.hpp"
 
 namespace sflsh {
 

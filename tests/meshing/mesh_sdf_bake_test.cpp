@@ -1,7 +1,7 @@
 // Mesh SDF baking against exact CGAL distances (a separate AABB tree over
 // the triangles, sign from the generalized winding number), the closedness
 // check, and the disk cache.
-#include "sflsh/mesh/mesh_sdf_bake.hpp"
+#include "sflsh/meshing/mesh_sdf_bake.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include <random>
 
 #include "sflsh/io/mesh_export.hpp"
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 #include "test_support.hpp"
 
 namespace sflsh {

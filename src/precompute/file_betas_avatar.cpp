@@ -1,4 +1,4 @@
-#include "sflsh/scene/file_betas_avatar.hpp"
+#include "sflsh/precompute/file_betas_avatar.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sflsh/asset/avatar_file.hpp"
-#include "sflsh/asset/precompute.hpp"
+#include "sflsh/precompute/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/fnv_hash.hpp"

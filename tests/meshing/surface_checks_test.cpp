@@ -1,5 +1,5 @@
 // Surface checks on hand-made meshes whose answers are known.
-#include "sflsh/mesh/surface_checks.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "sflsh/asset/precompute.hpp"
+#include "sflsh/precompute/precompute.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "sflsh/scene/stress_run.hpp"
+#include "sflsh/bench/stress_run.hpp"
 
 #include <algorithm>
 #include <cmath>
