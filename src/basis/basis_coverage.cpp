@@ -55,7 +55,7 @@ std::string BasisCoverage::describe(const std::vector<std::string>& names) const
     const RegionCoverage& g = regions[r];
     if (g.handles == 0 && g.skin_nodes == 0) continue;
     const std::string name = r < names.size() ? names[r] : "region " + std::to_string(r);
-    o << "  " << std::left << std::setw(10) << name << std::right << std::setw(4) << g.handles << " handles, "
+    o << "  " << std::left << std::setw(10) << name << std::right << std::setw(4) << g.handles << (g.handles == 1 ? " handle,  " : " handles, ")
       << std::setw(5) << g.skin_nodes << " skin nodes, " << std::setw(5) << 100.0 * g.share() << " % covered\n";
   }
   return o.str();
