@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "sflsh/basis/handle_placement.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
@@ -48,6 +49,13 @@ AvatarSummary summarize_avatar(const Avatar& a) {
         s.max_weight = std::max(s.max_weight, it.value());
       }
   }
+  s.region_names.clear();
+  for (const RegionMaterial& m : a.materials) s.region_names.push_back(m.name);
+  if (a.num_handles() > 0 && a.W.rows() == s.tet_nodes && a.tet_region.size() == s.tets) {
+    const VecXi node_region = basis::node_regions_from_tets(a.tet, a.tet_region, s.regions);
+    s.coverage = basis::basis_coverage(a.W, a.node_role, a.surface_nodes, node_region, s.regions,
+                                       basis::nearest_nodes(a.tet.nodes, a.handles));
+  }
   s.height_m = a.surface_rest.col(1).maxCoeff() - a.surface_rest.col(1).minCoeff();
   std::ostringstream b;
   for (Eigen::Index i = 0; i < a.betas.size(); ++i) b << (i ? "," : "") << a.betas[i];
@@ -72,6 +80,10 @@ std::string AvatarSummary::to_text(const std::string& title) const {
     << " non-zero weights in [" << min_weight << ", " << max_weight << "], max sum excess " << max_partition_error << "\n"
     << "  cubature          elastic " << elastic_samples << " samples (volume " << elastic_volume_m3 << " m^3), inertia "
     << inertia_samples << " samples (volume " << inertia_volume_m3 << " m^3, mass " << inertia_mass_kg << " kg)\n";
+  if (coverage.skin_nodes > 0) {
+    std::istringstream lines(coverage.describe(region_names));
+    for (std::string line; std::getline(lines, line);) o << "  " << line << "\n";
+  }
   return o.str();
 }
 
@@ -91,7 +103,18 @@ std::string AvatarSummary::to_json() const {
     << "  \"elastic_volume_m3\": " << elastic_volume_m3 << ",\n  \"inertia_volume_m3\": " << inertia_volume_m3 << ",\n"
     << "  \"inertia_mass_kg\": " << inertia_mass_kg << ",\n  \"max_partition_error\": " << max_partition_error << ",\n"
     << "  \"min_weight\": " << min_weight << ",\n  \"max_weight\": " << max_weight << ",\n"
-    << "  \"height_m\": " << height_m << "\n}\n";
+    << "  \"height_m\": " << height_m << ",\n"
+    << "  \"soft_coverage\": {\"threshold\": " << coverage.threshold << ", \"skin_nodes\": " << coverage.skin_nodes
+    << ", \"covered\": " << coverage.covered << ", \"share\": " << coverage.share() << ", \"regions\": {";
+  bool first = true;
+  for (size_t r = 0; r < coverage.regions.size(); ++r) {
+    const basis::RegionCoverage& g = coverage.regions[r];
+    o << (first ? "" : ", ") << "\"" << (r < region_names.size() ? region_names[r] : std::to_string(r))
+      << "\": {\"handles\": " << g.handles << ", \"skin_nodes\": " << g.skin_nodes << ", \"covered\": " << g.covered
+      << "}";
+    first = false;
+  }
+  o << "}}\n}\n";
   return o.str();
 }
 

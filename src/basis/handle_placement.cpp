@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sflsh/asset/avatar.hpp"
+#include "sflsh/basis/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::basis {
@@ -109,45 +110,135 @@ void check_roles(const TetMesh& mesh, const VecXi& node_role) {
 
 }  // namespace
 
+VecXi allocate_handles(const VecX& weights, const VecXi& capacity, int K, int min_per_region, double min_fraction) {
+  const Eigen::Index R = weights.size();
+  require(capacity.size() == R, "handle allocation: ", capacity.size(), " capacities for ", R, " regions");
+  require(weights.allFinite() && (R == 0 || weights.minCoeff() >= 0.0),
+          "handle allocation: region weights must be finite and non-negative");
+  require(R == 0 || capacity.minCoeff() >= 0, "handle allocation: region capacities must be non-negative");
+  require(K >= 0 && min_per_region >= 0, "handle allocation: K and the minimum per region must be non-negative");
+  const double min_weight = min_fraction * weights.sum();
+  VecXi n = VecXi::Zero(R);
+  // One handle to the region that wants it most (Sainte-Laguë quotient), among
+  // those below `cap(r)`; false when none is.
+  auto give_one = [&](auto cap) {
+    Eigen::Index best = -1;
+    double best_q = -1.0;
+    for (Eigen::Index r = 0; r < R; ++r)
+      if (n[r] < cap(r)) {
+        const double q = weights[r] / (n[r] + 0.5);
+        if (q > best_q) best_q = q, best = r;
+      }
+    if (best < 0) return false;
+    ++n[best];
+    return true;
+  };
+  auto up_to_minimum = [&](Eigen::Index r) {
+    return weights[r] >= min_weight ? std::min(min_per_region, capacity[r]) : 0;
+  };
+  int left = K;
+  while (left > 0 && give_one(up_to_minimum)) --left;
+  while (left > 0 && give_one([&](Eigen::Index r) { return capacity[r]; })) --left;
+  return n;
+}
+
+VecXi node_regions_from_tets(const TetMesh& mesh, const VecXi& tet_region, int num_regions) {
+  require(tet_region.size() == mesh.num_elements(), "node regions: tet_region has ", tet_region.size(),
+          " entries, expected #T = ", mesh.num_elements());
+  require(num_regions > 0 &&
+              (tet_region.size() == 0 || (tet_region.minCoeff() >= 0 && tet_region.maxCoeff() < num_regions)),
+          "node regions: tet region labels must lie in [0, ", num_regions, ")");
+  const int n = mesh.num_nodes();
+  MatX volume = MatX::Zero(n, num_regions);
+  const VecX tet_volume = tet_volumes(mesh);
+  for (int t = 0; t < mesh.num_elements(); ++t)
+    for (int a = 0; a < 4; ++a) volume(mesh.elements(t, a), tet_region[t]) += std::abs(tet_volume[t]);
+  VecXi out = VecXi::Constant(n, -1);
+  for (int i = 0; i < n; ++i)
+    for (int r = 0; r < num_regions; ++r)
+      if (volume(i, r) > 0.0 && (out[i] < 0 || volume(i, r) > volume(i, out[i]))) out[i] = r;
+  return out;
+}
+
 HandleSet select_handles(const TetMesh& mesh, const VecXi& node_role, int K, const VecX& thickness,
-                         const HandlePlacementOptions& options) {
+                         const VecXi& node_region, const HandlePlacementOptions& options) {
   check_roles(mesh, node_role);
   const int n = mesh.num_nodes();
-  VecX scale = VecX::Ones(n);
+  VecX t_rel = VecX::Ones(n);  // thickness / mean thickness
   if (thickness.size() > 0) {
     require(thickness.size() == n, "handle placement: thickness has ", thickness.size(), " entries, expected #N = ", n);
     require(thickness.allFinite() && thickness.minCoeff() > 0.0,
             "handle placement: tissue thickness must be finite and positive (m)");
-    const double mean = thickness.mean();
-    for (int i = 0; i < n; ++i) scale(i) = std::pow(thickness(i) / mean, options.thickness_exponent);
+    t_rel = thickness / thickness.mean();
   }
+  require(options.dirichlet_distance_scale > 0.0, "handle placement: dirichlet_distance_scale must be positive, got ",
+          options.dirichlet_distance_scale);
   std::vector<int> simulated, dirichlet;
-  for (int i = 0; i < n; ++i) (node_role(i) == int(NodeRole::Simulated) ? simulated : dirichlet).push_back(i);
-  require(K > 0 && K <= int(simulated.size()), "handle placement: asked for ", K, " handles but the mesh has ",
-          simulated.size(), " Simulated nodes");
-
-  const auto graph = edge_graph(mesh, scale);
-  std::vector<double> dist(n, kInf);
   std::vector<char> in_mesh(n, 0);
   for (int e = 0; e < mesh.num_elements(); ++e)
     for (int a = 0; a < 4; ++a) in_mesh[mesh.elements(e, a)] = 1;
-  if (!dirichlet.empty()) relax_from(graph, dirichlet, dist);
+  for (int i = 0; i < n; ++i)
+    if (node_role(i) != int(NodeRole::Simulated))
+      dirichlet.push_back(i);
+    else if (in_mesh[i])
+      simulated.push_back(i);
+  require(K > 0 && K <= int(simulated.size()), "handle placement: asked for ", K, " handles but the mesh has ",
+          simulated.size(), " Simulated nodes");
+
+  // Region of each Simulated node (0 when no labels are given).
+  VecXi region = VecXi::Zero(n);
+  if (node_region.size() > 0) {
+    require(node_region.size() == n, "handle placement: node_region has ", node_region.size(),
+            " entries, expected #N = ", n);
+    for (int i : simulated) {
+      require(node_region[i] >= 0, "handle placement: Simulated node ", i, " has no region (label ", node_region[i],
+              ")");
+      region[i] = node_region[i];
+    }
+  }
+  const int R = 1 + region.maxCoeff();
+  const VecX lumped = lumped_mass(mesh);  // m^3 (unit density)
+  VecX weight = VecX::Zero(R);
+  VecXi capacity = VecXi::Zero(R);
+  for (int i : simulated) {
+    weight[region[i]] += lumped[i] * std::pow(t_rel[i], options.allocation_thickness_exponent);
+    ++capacity[region[i]];
+  }
+  const VecXi quota = allocate_handles(weight, capacity, K, options.min_per_region, options.min_region_fraction);
+
+  VecX scale(n);
+  for (int i = 0; i < n; ++i) scale(i) = std::pow(t_rel(i), options.thickness_exponent);
+  const auto graph = edge_graph(mesh, scale);
+  std::vector<double> dist(n, kInf);
+  if (!dirichlet.empty()) {
+    relax_from(graph, dirichlet, dist);
+    for (double& d : dist) d *= options.dirichlet_distance_scale;
+  }
 
   HandleSet hs;
   hs.nodes.resize(K);
+  VecXi count = VecXi::Zero(R);
   for (int k = 0; k < K; ++k) {
+    // The region furthest below its quota (smallest filled fraction).
+    int r = -1;
+    for (int q = 0; q < R; ++q)
+      if (count[q] < quota[q] && (r < 0 || double(count[q]) / quota[q] < double(count[r]) / quota[r])) r = q;
     int pick = -1;
     if (k == 0 && dirichlet.empty()) {
+      std::vector<int> candidates;
+      for (int i : simulated)
+        if (region[i] == r) candidates.push_back(i);
       std::mt19937 rng(options.seed);
-      pick = simulated[std::uniform_int_distribution<size_t>(0, simulated.size() - 1)(rng)];
+      pick = candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng)];
     } else {
-      // Farthest Simulated node; unreachable ones (another component) first.
+      // Farthest Simulated node of region r; unreachable ones (another component) first.
       double best = -1.0;
       for (int i : simulated)
-        if (in_mesh[i] && dist[i] > best) best = dist[i], pick = i;
-      require(pick >= 0 && best > 0.0, "handle placement: no Simulated node left for handle ", k);
+        if (region[i] == r && dist[i] > best) best = dist[i], pick = i;
+      require(pick >= 0 && best > 0.0, "handle placement: no Simulated node left for handle ", k, " in region ", r);
     }
     hs.nodes(k) = pick;
+    ++count[r];
     relax_from(graph, {pick}, dist);
   }
   hs.positions.resize(K, 3);

@@ -128,16 +128,21 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   a.model_source = model.source;
 
   t.reset();
-  basis::HandleSet handles =
-      options.handle_positions.rows() > 0
-          ? basis::snap_handles(a.tet, a.node_role, options.handle_positions)
-          : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, a), options.placement);
+  const int num_regions = int(a.materials.size());
+  const VecXi node_region = basis::node_regions_from_tets(a.tet, a.tet_region, num_regions);
+  basis::HandleSet handles = options.handle_positions.rows() > 0
+                                 ? basis::snap_handles(a.tet, a.node_role, options.handle_positions)
+                                 : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, a),
+                                                         node_region, options.placement);
   a.handles = handles.positions;
   r.handles_s = t.seconds();
 
   t.reset();
   a.W = basis::bounded_biharmonic_weights(a.tet, a.node_role, handles.nodes, options.bbw, &r.bbw_report);
   r.weights_s = t.seconds();
+  r.coverage = basis::basis_coverage(a.W, a.node_role, a.surface_nodes, node_region, num_regions, handles.nodes);
+  r.region_names.clear();
+  for (const RegionMaterial& m : a.materials) r.region_names.push_back(m.name);
 
   t.reset();
   // Inertia: data-oblivious cubature (Tapia et al. 2021), samples at the
@@ -209,6 +214,7 @@ std::string PrecomputeReport::describe() const {
     << " s, weights " << weights_s << " s, cubature " << cubature_s << " s), peak memory " << peak_rss_mib << " MiB\n";
   if (!template_from_cache) o << template_report.describe() << "\n";
   o << shape_report.describe() << "\n" << bbw_report.summary() << "\n";
+  // (coverage: printed by the avatar summary, see summarize_avatar.)
   o << std::setprecision(3);
   // CubatureErrors holds relative errors already.
   auto pct = [](double rel_err) { return 100.0 * std::abs(rel_err); };

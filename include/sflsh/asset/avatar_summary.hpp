@@ -2,8 +2,10 @@
 // Counts and quality figures of an avatar (printed by `sflsh inspect` and at the
 // end of `sflsh precompute`).
 #include <string>
+#include <vector>
 
 #include "sflsh/asset/avatar.hpp"
+#include "sflsh/basis/basis_coverage.hpp"
 
 namespace sflsh {
 
@@ -22,6 +24,10 @@ struct AvatarSummary {
   double max_partition_error = 0;  ///< max over simulated nodes of (Σ_k W_nk − 1) if > 0 (must be ≤ 0)
   double min_weight = 0, max_weight = 0;
   double height_m = 0;
+  /// Handles per region (by material name) and share of simulated skin nodes
+  /// (outer surface, role Simulated) with Σ_k W_k ≥ 0.5.
+  basis::BasisCoverage coverage;
+  std::vector<std::string> region_names;
   std::string betas, model_source, model_hash;
 
   std::string to_text(const std::string& title) const;

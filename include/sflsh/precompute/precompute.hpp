@@ -5,8 +5,10 @@
 //   shape stage (per β): shaped nodes + thickness map, handles, bounded
 //     biharmonic weights, data-oblivious cubature.
 #include <string>
+#include <vector>
 
 #include "sflsh/asset/avatar.hpp"
+#include "sflsh/basis/basis_coverage.hpp"
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/cubature.hpp"
 #include "sflsh/basis/handle_placement.hpp"
@@ -44,6 +46,9 @@ struct PrecomputeReport {
   TemplateReport template_report;  ///< valid when built (not loaded)
   ShapeReport shape_report;
   basis::BbwReport bbw_report;
+  /// Handles per region and the share of simulated skin nodes with Σ_k W_k ≥ 0.5.
+  basis::BasisCoverage coverage;
+  std::vector<std::string> region_names;  ///< #R, for coverage.describe
   basis::CubatureErrors elastic_errors, inertia_errors;
   basis::FittedCubatureReport elastic_fit;  ///< valid when options.fit_elastic_cubature
   double template_s = 0, shape_geometry_s = 0, handles_s = 0, weights_s = 0, cubature_s = 0;
