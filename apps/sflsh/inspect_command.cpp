@@ -5,7 +5,7 @@
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
-#include "sflsh/asset/avatar_summary.hpp"
+#include "sflsh/precompute/avatar_summary.hpp"
 
 namespace sflsh::cli {
 namespace {

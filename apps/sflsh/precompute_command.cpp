@@ -7,7 +7,7 @@
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
-#include "sflsh/asset/avatar_summary.hpp"
+#include "sflsh/precompute/avatar_summary.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"

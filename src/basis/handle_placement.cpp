@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "sflsh/asset/avatar.hpp"
-#include "sflsh/basis/tet_operators.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::basis {
@@ -150,7 +150,7 @@ VecXi node_regions_from_tets(const TetMesh& mesh, const VecXi& tet_region, int n
           "node regions: tet region labels must lie in [0, ", num_regions, ")");
   const int n = mesh.num_nodes();
   MatX volume = MatX::Zero(n, num_regions);
-  const VecX tet_volume = tet_volumes(mesh);
+  const VecX tet_volume = fem::tet_volumes(mesh);
   for (int t = 0; t < mesh.num_elements(); ++t)
     for (int a = 0; a < 4; ++a) volume(mesh.elements(t, a), tet_region[t]) += std::abs(tet_volume[t]);
   VecXi out = VecXi::Constant(n, -1);
@@ -197,7 +197,7 @@ HandleSet select_handles(const TetMesh& mesh, const VecXi& node_role, int K, con
     }
   }
   const int R = 1 + region.maxCoeff();
-  const VecX lumped = lumped_mass(mesh);  // m^3 (unit density)
+  const VecX lumped = fem::lumped_mass(mesh);  // m^3 (unit density)
   VecX weight = VecX::Zero(R);
   VecXi capacity = VecXi::Zero(R);
   for (int i : simulated) {

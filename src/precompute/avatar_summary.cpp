@@ -1,4 +1,4 @@
-#include "sflsh/asset/avatar_summary.hpp"
+#include "sflsh/precompute/avatar_summary.hpp"
 
 #include <cmath>
 #include <iomanip>
