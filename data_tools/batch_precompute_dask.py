@@ -60,16 +60,26 @@ def last_error_line(output):
     return lines[-1].strip() if lines else ""
 
 
+def sflsh_env():
+    """The environment for sflsh on a Dask worker. Dask's nanny sets
+    MALLOC_TRIM_THRESHOLD_=65536 for its workers (to return memory to the OS
+    sooner); sflsh, allocation-heavy C++, then spends 2x the CPU (5x the system
+    time) in the shape stage, so its child processes get the default back."""
+    env = dict(os.environ)
+    env.pop("MALLOC_TRIM_THRESHOLD_", None)
+    return env
+
+
 def prepare(sflsh, options, batch, out_dir):
     """Template stage into the cache once, then the plan. Runs as one Dask task."""
-    t = subprocess.run([sflsh, "-q", "precompute", "--template-only"] + options, capture_output=True, text=True)
+    t = subprocess.run([sflsh, "-q", "precompute", "--template-only"] + options, capture_output=True, text=True, env=sflsh_env())
     if t.returncode != 0:
         raise RuntimeError("template stage failed: " + last_error_line(t.stderr + t.stdout))
     with tempfile.TemporaryDirectory() as tmp:
         plan = os.path.join(tmp, "plan.csv")
         p = subprocess.run([sflsh, "-q", "precompute"] + options +
                            ["--batch", batch, "--out-dir", out_dir, "--dry-run", "--manifest", plan],
-                           capture_output=True, text=True)
+                           capture_output=True, text=True, env=sflsh_env())
         if not os.path.exists(plan):
             raise RuntimeError("planning the batch failed: " + last_error_line(p.stderr + p.stdout))
         with open(plan) as f:
@@ -84,14 +94,14 @@ def run_row(sflsh, options, batch, out_dir, row):
     except (ImportError, ValueError):
         worker = ""
     result = {"row": row, "status": "failed", "seconds": 0.0, "shape_seconds": 0.0, "peak_rss_mib": 0.0,
-              "worker": worker, "error": ""}
+              "worker": worker, "error": "", "t_start": time.time()}
     tmp = tempfile.mkdtemp(prefix="sflsh-task-")
     try:
         manifest = os.path.join(tmp, "row.csv")
         start = time.perf_counter()
         p = subprocess.run([sflsh, "-q", "precompute"] + options +
                            ["--batch", batch, "--out-dir", out_dir, "--task-index", str(row), "--manifest", manifest],
-                           capture_output=True, text=True)
+                           capture_output=True, text=True, env=sflsh_env())
         result["seconds"] = time.perf_counter() - start
         records = []
         if os.path.exists(manifest):
@@ -109,13 +119,33 @@ def run_row(sflsh, options, batch, out_dir, row):
         result["error"] = "cannot run %s: %s" % (sflsh, e)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    result["t_end"] = time.time()
     return result
+
+
+def overheads(results):
+    """Mean dispatch gap (a task's end to the next task's start on the same
+    worker, the worker's clock), mean result latency (a task's end to the
+    driver holding its result; needs synchronised clocks) and mean sflsh
+    start-up (the process's time minus its own time for the row)."""
+    gaps, latency, startup = [], [], []
+    by_worker = {}
+    for r in results:
+        by_worker.setdefault(r["worker"], []).append(r)
+        latency.append(r["t_result"] - r["t_end"])
+        if r["status"] == "built":
+            startup.append(r["seconds"] - r["shape_seconds"])
+    for tasks in by_worker.values():
+        tasks.sort(key=lambda r: r["t_start"])
+        gaps += [b["t_start"] - a["t_end"] for a, b in zip(tasks, tasks[1:])]
+    mean = lambda v: sum(v) / len(v) if v else float("nan")
+    return mean(gaps), mean(latency), mean(startup)
 
 
 def write_csv(rows, path):
     tmp = path + ".partial"
     with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=OUTPUT_FIELDS, extrasaction="ignore")
+        w = csv.DictWriter(f, fieldnames=OUTPUT_FIELDS, extrasaction="ignore", lineterminator="\n")
         w.writeheader()
         for r in sorted(rows, key=lambda r: int(r["row"])):
             w.writerow(r)
@@ -180,10 +210,15 @@ def main(argv=None):
         futures = [client.submit(run_row, sflsh, options, batch, out_dir, row, pure=False, key="sflsh-row-%d" % row)
                    for row in pending]
         done = failed = 0
+        results = []
         for fut in as_completed(futures):
             res = fut.result()
+            res["t_result"] = time.time()
+            results.append(res)
             r = rows[res["row"]]
-            r.update({k: res[k] for k in ("status", "seconds", "shape_seconds", "peak_rss_mib", "worker", "error")})
+            r.update({k: res[k] for k in ("status", "worker", "error")})
+            r.update(seconds="%.3f" % res["seconds"], shape_seconds="%.3f" % res["shape_seconds"],
+                     peak_rss_mib="%.1f" % res["peak_rss_mib"])
             done += 1
             failed += res["status"] == "failed"
             elapsed = time.perf_counter() - t2
@@ -206,12 +241,14 @@ def main(argv=None):
     counts = {}
     for r in rows.values():
         counts[r["status"]] = counts.get(r["status"], 0) + 1
-    task_s = sum(float(r["seconds"]) for row, r in rows.items() if row in pending)
-    nworkers = args.workers if not args.scheduler else max(1, len({r["worker"] for r in rows.values() if r["worker"]}))
-    print("summary: %d rows: %s; tasks %.1f s wall on %d workers, %.2f s per task in sflsh, "
-          "driver overhead %.2f s per task ((wall x workers - sum of task times) / tasks)"
-          % (len(rows), ", ".join("%d %s" % (n, s) for s, n in sorted(counts.items())), t_tasks, nworkers,
-             task_s / max(1, len(pending)), (t_tasks * nworkers - task_s) / max(1, len(pending))))
+    task_s = sum(r["seconds"] for r in results)
+    nworkers = len({r["worker"] for r in results})
+    gap, latency, startup = overheads(results)
+    print("summary: %d rows: %s; %d tasks in %.1f s wall on %d workers, %.2f s per task in sflsh "
+          "(of which %.2f s sflsh start-up: model + cached template load); Dask overhead per task: "
+          "%.3f s between tasks on a worker, %.3f s from a task's end to its result at the driver"
+          % (len(rows), ", ".join("%d %s" % (n, s) for s, n in sorted(counts.items())), len(results), t_tasks,
+             nworkers, task_s / max(1, len(results)), startup, gap, latency))
     peak = max([float(r["peak_rss_mib"]) for r in built] or [0.0])
     print("peak memory per worker task %.0f MiB; manifest %s" % (peak, out_csv))
     bad = sorted((row, r) for row, r in rows.items() if r["status"] == "failed")

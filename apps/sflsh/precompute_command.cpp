@@ -1,4 +1,6 @@
 // `sflsh precompute`: body model + shape β → avatar HDF5 file(s).
+#include <stdlib.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <functional>
@@ -107,6 +109,10 @@ void run_in_workers(const PrecomputeArgs& a, const PrecomputeOptions& o, int job
     s << "row-" << std::setw(6) << std::setfill('0') << row;
     return (logs / s.str()).string();
   };
+  // The workers are the parallelism: one OpenMP thread each inside CHOLMOD
+  // (spinning OpenMP threads of several processes would fight over the
+  // cores), unless the user set it. The weights stage keeps its own threads.
+  setenv("OMP_NUM_THREADS", "1", 0);
   ChildProcesses workers;
   std::map<int, size_t> running;  // pid -> record
   auto collect = [&] {

@@ -167,11 +167,14 @@ std::vector<BatchShape> read_batch_shapes(const std::string& path, int model_bet
   return rows;
 }
 
-std::string avatar_content_key(const BodyModel& model, const VecX& betas, const PrecomputeOptions& o) {
+namespace {
+
+/// Everything in the content key except β (hashing the model costs ~tens of
+/// ms: plan_batch computes this once for all rows).
+std::string key_prefix(const BodyModel& model, const PrecomputeOptions& o) {
   std::ostringstream s;
   s << std::setprecision(17) << "avatar|" << kAvatarFormatVersion << '|' << body_model_hash(model) << '|'
-    << template_cache_key(model, o.template_stage) << "|betas";
-  for (Eigen::Index i = 0; i < betas.size(); ++i) s << ',' << betas[i];
+    << template_cache_key(model, o.template_stage);
   const ShapeOptions& so = o.shape_stage;
   s << "|shape," << so.min_depth << ',' << so.scale_smoothing_iterations << ',' << so.capsule_percentile << ','
     << so.max_relax_rounds << ',' << so.min_dihedral_deg << "|thickness";
@@ -181,10 +184,23 @@ std::string avatar_content_key(const BodyModel& model, const VecX& betas, const 
   s << "|placement," << o.placement.thickness_exponent << ',' << o.placement.seed;
   s << "|bbw," << o.bbw.max_iterations << ',' << o.bbw.pdas_iterations << ',' << o.bbw.multiplier_tolerance << ','
     << o.bbw.drop_tolerance << ',' << o.bbw.initial_radius_factor << ',' << o.bbw.max_border_columns;
-  s << "|cubature," << o.elastic_samples_per_cell << ',' << o.fit_elastic_cubature;
+  s << "|cubature," << o.elastic_samples_per_cell << ',' << o.fit_elastic_cubature << "|betas";
+  return s.str();
+}
+
+std::string key_of(const std::string& prefix, const VecX& betas) {
+  std::ostringstream s;
+  s << std::setprecision(17) << prefix;
+  for (Eigen::Index i = 0; i < betas.size(); ++i) s << ',' << betas[i];
   Fnv1a64 h;
   h.add(s.str());
   return h.hex();
+}
+
+}  // namespace
+
+std::string avatar_content_key(const BodyModel& model, const VecX& betas, const PrecomputeOptions& o) {
+  return key_of(key_prefix(model, o), betas);
 }
 
 std::string batch_avatar_file_name(const std::string& key) { return "avatar-" + key + ".h5"; }
@@ -231,9 +247,10 @@ std::vector<BatchRecord> plan_batch(const std::vector<BatchShape>& shapes, const
   const std::string model_hash = body_model_hash(model);
   std::map<std::string, int> first_row;  // over the whole file, so every slice agrees
   std::vector<std::string> keys(shapes.size());
+  const std::string prefix = key_prefix(model, options);
   for (const BatchShape& s : shapes) {
     if (!s.error.empty()) continue;
-    keys[s.row] = avatar_content_key(model, s.betas, options);
+    keys[s.row] = key_of(prefix, s.betas);
     first_row.emplace(keys[s.row], s.row);
   }
   std::vector<BatchRecord> out;
