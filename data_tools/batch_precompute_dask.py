@@ -72,7 +72,8 @@ def sflsh_env():
 
 def prepare(sflsh, options, batch, out_dir):
     """Template stage into the cache once, then the plan. Runs as one Dask task."""
-    t = subprocess.run([sflsh, "-q", "precompute", "--template-only"] + options, capture_output=True, text=True, env=sflsh_env())
+    t = subprocess.run([sflsh, "-q", "precompute", "--template-only"] + options, capture_output=True, text=True,
+                       env=sflsh_env())
     if t.returncode != 0:
         raise RuntimeError("template stage failed: " + last_error_line(t.stderr + t.stdout))
     with tempfile.TemporaryDirectory() as tmp:

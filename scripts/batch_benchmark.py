@@ -44,6 +44,7 @@ def main():
     ap.add_argument("--handles", type=int, default=16)
     ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results"))
     ap.add_argument("--ways", default="serial,jobs2,dask1,dask2")
+    ap.add_argument("--suffix", default="", help="appended to the result file names (e.g. _omp1)")
     args = ap.parse_args()
     sflsh = os.path.abspath(args.sflsh)
     opts = ["--handles", str(args.handles)]
@@ -91,7 +92,7 @@ def main():
         if way.startswith("dask"):
             row["shape_seconds_mean"] = round(sum(float(r["shape_seconds"]) for r in built) / len(built), 2)
         rows.append(row)
-        shutil.copy(manifest, os.path.join(args.out, "batch_manifest_%s.csv" % way))
+        shutil.copy(manifest, os.path.join(args.out, "batch_manifest_%s%s.csv" % (way, args.suffix)))
         print(row, file=sys.stderr)
 
     rebuilt = os.stat(cache).st_mtime_ns != cache_mtime
@@ -101,20 +102,22 @@ def main():
                     for w in dirs for n in names)
     by = {r["way"]: r for r in rows}
     for r in rows:
-        ref = by["serial"] if r["way"] in ("serial", "jobs2") else by.get("dask1", by["serial"])
+        ref = by.get("serial", r) if r["way"] in ("serial", "jobs2") else by.get("dask1", r)
         r["speedup"] = round(ref["wall_s"] / r["wall_s"], 2)
     fields = ["way", "shapes", "handles", "wall_s", "wall_per_shape_s", "cpu_s", "row_seconds_mean",
               "shape_seconds_mean", "peak_rss_mib_max", "speedup", "load_before", "load_after", "summary"]
-    with open(os.path.join(args.out, "batch_benchmark.csv"), "w", newline="") as f:
+    with open(os.path.join(args.out, "batch_benchmark%s.csv" % args.suffix), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
         w.writeheader()
         for r in rows:
             w.writerow(r)
-    with open(os.path.join(args.out, "batch_benchmark.md"), "w") as f:
+    with open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix), "w") as f:
         f.write("# Batch precompute benchmark\n\n")
-        f.write("`/usr/bin/python3 scripts/batch_benchmark.py --shapes %d --handles %d` on %s, %d cores "
+        f.write("`%s/usr/bin/python3 scripts/batch_benchmark.py --shapes %d --handles %d%s` on %s, %d cores "
                 "(shared with other users' builds: load average %.1f-%.1f during the runs, so wall times are noisy).\n\n"
-                % (args.shapes, args.handles, os.uname().nodename, os.cpu_count(),
+                % ("OMP_NUM_THREADS=%s " % os.environ["OMP_NUM_THREADS"] if "OMP_NUM_THREADS" in os.environ else "",
+                   args.shapes, args.handles, " --ways %s --suffix %s" % (args.ways, args.suffix) if args.suffix else "",
+                   os.uname().nodename, os.cpu_count(),
                    min(r["load_before"] for r in rows), max(r["load_after"] for r in rows)))
         f.write("| way | wall (s) | wall per shape (s) | CPU (s) | row time, mean (s) | peak RSS per worker (MiB) "
                 "| speed-up |\n|---|---|---|---|---|---|---|\n")
@@ -130,7 +133,7 @@ def main():
             if r["summary"]:
                 f.write("\n%s: `%s`\n" % (r["way"], r["summary"]))
     shutil.rmtree(work, ignore_errors=True)
-    print(open(os.path.join(args.out, "batch_benchmark.md")).read())
+    print(open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix)).read())
 
 
 if __name__ == "__main__":
