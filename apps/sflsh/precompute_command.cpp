@@ -1,17 +1,25 @@
 // `sflsh precompute`: body model + shape β → avatar HDF5 file(s).
+#include <stdlib.h>
+
+#include <algorithm>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
+#include <thread>
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
+#include "sflsh/precompute/batch_precompute.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/child_processes.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
+#include "sflsh/core/timer.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -23,32 +31,11 @@ struct PrecomputeArgs {
   int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
   bool no_fit_cubature = false;
   std::string handles_file, thickness_map, out = "avatar.h5", batch, out_dir, cache_dir;
-  bool no_cache = false;
+  bool no_cache = false, template_only = false, dry_run = false;
   double cell_size = 0, facet_size = 0, facet_distance = 0;
+  int jobs = 0, task_index = -1;
+  std::string shard, manifest;
 };
-
-/// Reads one β vector per line ("b0,b1,..."); a first line that is not
-/// numeric is a header. Throws naming the file and line.
-std::vector<VecX> read_betas_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path, ": cannot open betas file");
-  std::vector<VecX> rows;
-  std::string line;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    try {
-      rows.push_back(parse_betas(line));
-    } catch (const Error& e) {
-      if (lineno == 1 && rows.empty()) continue;  // header
-      fail(path, ":", lineno, ": ", e.what());
-    }
-  }
-  if (rows.empty()) fail(path, ": no rows of betas found");
-  return rows;
-}
 
 PrecomputeOptions make_options(const PrecomputeArgs& a) {
   PrecomputeOptions o;
@@ -74,38 +61,196 @@ void build_one(const BodyModel& model, const TemplateVolume& tv, const VecX& bet
   std::cout << summarize_avatar(avatar).to_text("wrote " + out) << report.describe();
 }
 
-void run_precompute(const PrecomputeArgs& a) {
-  const PrecomputeOptions o = make_options(a);
-  std::vector<VecX> shapes;
-  if (!a.batch.empty()) {
-    require(!a.out_dir.empty(), "--batch needs --out-dir");
-    require(a.betas.empty(), "--batch and --betas exclude each other");
-    shapes = read_betas_csv(a.batch);
-    std::error_code ec;
-    std::filesystem::create_directories(a.out_dir, ec);
-    if (ec) fail(a.out_dir, ": cannot create output folder: ", ec.message());
-  } else {
-    shapes.push_back(a.betas.empty() ? VecX() : parse_betas(a.betas));
+std::string number(double v) {
+  std::ostringstream s;
+  s << std::setprecision(17) << v;
+  return s.str();
+}
+
+/// The command line of a worker that builds data row `row` alone and writes
+/// its record to `manifest`: this executable with the same options.
+std::vector<std::string> worker_command(const PrecomputeArgs& a, const PrecomputeOptions& o, int row,
+                                        const std::string& manifest) {
+  std::vector<std::string> c = {self_executable(), "-q", "precompute", "--model", a.model, "--handles",
+                                std::to_string(a.handles), "--elastic-samples-per-cell",
+                                std::to_string(a.elastic_samples_per_cell), "--cache-dir", o.cache_dir};
+  if (a.no_fit_cubature) c.push_back("--no-fit-cubature");
+  for (const auto& [flag, value] : {std::pair<const char*, const std::string*>{"--handles-file", &a.handles_file},
+                                    {"--thickness-map", &a.thickness_map}})
+    if (!value->empty()) c.insert(c.end(), {flag, *value});
+  for (const auto& [flag, value] :
+       {std::pair<const char*, double>{"--cell-size", a.cell_size}, {"--facet-size", a.facet_size},
+        {"--facet-distance", a.facet_distance}})
+    if (value > 0) c.insert(c.end(), {flag, number(value)});
+  c.insert(c.end(), {"--batch", a.batch, "--out-dir", a.out_dir, "--task-index", std::to_string(row), "--manifest",
+                     manifest});
+  return c;
+}
+
+std::string default_manifest(const PrecomputeArgs& a, const BatchShard& shard) {
+  std::string name = "manifest.csv";
+  if (a.task_index >= 0)
+    name = "manifest-task-" + std::to_string(a.task_index) + ".csv";
+  else if (shard.count > 1)
+    name = "manifest-shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count) + ".csv";
+  return (std::filesystem::path(a.out_dir) / name).string();
+}
+
+/// Runs the pending rows of `records`, `jobs` at a time, each in a worker
+/// process (worker_command); fills in their records. `on_done` is called after each.
+void run_in_workers(const PrecomputeArgs& a, const PrecomputeOptions& o, int jobs, std::vector<BatchRecord>& records,
+                    const std::function<void(const BatchRecord&)>& on_done) {
+  const std::filesystem::path logs = std::filesystem::path(a.out_dir) / "logs";
+  std::error_code ec;
+  std::filesystem::create_directories(logs, ec);
+  if (ec) fail(logs.string(), ": cannot create the worker log folder: ", ec.message());
+  auto stem = [&](int row) {
+    std::ostringstream s;
+    s << "row-" << std::setw(6) << std::setfill('0') << row;
+    return (logs / s.str()).string();
+  };
+  // The workers are the parallelism: one OpenMP thread each inside CHOLMOD
+  // (spinning OpenMP threads of several processes would fight over the
+  // cores), unless the user set it. The weights stage keeps its own threads.
+  setenv("OMP_NUM_THREADS", "1", 0);
+  ChildProcesses workers;
+  std::map<int, size_t> running;  // pid -> record
+  auto collect = [&] {
+    const ChildExit e = workers.wait_any();
+    BatchRecord& r = records[running.at(e.pid)];
+    running.erase(e.pid);
+    const std::string base = stem(r.row);
+    BatchRecord reported;
+    bool have = false;
+    try {
+      const auto rows = read_batch_manifest(base + ".csv");
+      have = rows.size() == 1 && rows[0].row == r.row;
+      if (have) reported = rows[0];
+    } catch (const Error&) {
+    }
+    if (have && (e.exit_code == 0) == (reported.status != "failed")) {
+      r.status = reported.status;
+      r.error = reported.error;
+    } else {
+      r.status = "failed";
+      r.error = "worker " + e.describe() + (have && !reported.error.empty() ? ": " + reported.error : "");
+    }
+    r.seconds = e.seconds;
+    r.peak_rss_mib = e.peak_rss_mib;
+    std::filesystem::remove(base + ".csv", ec);
+    if (r.status == "failed")
+      r.error += " (log: " + base + ".log)";
+    else
+      std::filesystem::remove(base + ".log", ec);
+    on_done(r);
+  };
+  for (size_t i = 0; i < records.size(); ++i) {
+    if (records[i].status != "pending") continue;
+    while (workers.running() >= jobs) collect();
+    const std::string base = stem(records[i].row);
+    running[workers.start(worker_command(a, o, records[i].row, base + ".csv"), base + ".log")] = i;
   }
+  while (workers.running() > 0) collect();
+  std::filesystem::remove(logs, ec);  // only when empty: every row succeeded
+}
+
+void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
+  require(!a.out_dir.empty(), "--batch needs --out-dir");
+  require(a.betas.empty(), "--batch and --betas exclude each other");
+  require(a.task_index < 0 || a.shard.empty(), "--task-index and --shard exclude each other");
+  require(a.jobs >= 0 && a.jobs <= 1024, "--jobs must be in [1, 1024] (or 0 for all cores), got ", a.jobs);
+  const BatchShard shard = a.shard.empty() ? BatchShard{} : parse_batch_shard(a.shard);
+  o.bbw.show_progress = false;  // the batch prints its own progress
   const BodyModel model = load_body_model(a.model);
-  for (const auto& b : shapes)
-    require(b.size() <= model.num_betas(), "betas have ", b.size(), " entries but the model has ", model.num_betas(),
-            " shape directions");
-  PrecomputeReport report;
-  const TemplateVolume tv = cached_template_volume(model, o, &report);
-  if (a.batch.empty()) {
-    build_one(model, tv, shapes[0], o, report, a.out);
+  const std::vector<BatchShape> shapes = read_batch_shapes(a.batch, model.num_betas());
+  require(a.task_index < int(shapes.size()), a.batch, ": --task-index ", a.task_index, " but the file has ",
+          shapes.size(), " data rows (task indices 0 to ", shapes.size() - 1, ")");
+  std::error_code ec;
+  std::filesystem::create_directories(a.out_dir, ec);
+  if (ec) fail(a.out_dir, ": cannot create output folder: ", ec.message());
+  const std::string manifest = a.manifest.empty() ? default_manifest(a, shard) : a.manifest;
+
+  Timer wall;
+  std::vector<BatchRecord> records = plan_batch(shapes, model, o, a.out_dir, shard, a.task_index);
+  int pending = 0;
+  for (const BatchRecord& r : records) pending += r.status == "pending";
+  // Failed rows are reported even with --quiet.
+  auto report_failure = [&](const BatchRecord& r) {
+    std::cerr << "batch: row " << r.row << " (" << a.batch << " line " << r.line << ") failed: " << r.error << "\n";
+  };
+  for (const BatchRecord& r : records)
+    if (r.status == "failed") report_failure(r);
+  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs = std::max(1, std::min(pending, a.task_index >= 0 ? 1 : (a.jobs > 0 ? a.jobs : cores)));
+  log_info("batch: " + std::to_string(records.size()) + " rows in this run, " + std::to_string(pending) +
+           " to build" + (pending > 1 ? " with " + std::to_string(jobs) + (jobs > 1 ? " worker processes" : " process") : "") +
+           ", " + std::to_string(int(records.size()) - pending) + " done already, duplicate or invalid");
+  write_batch_manifest(records, manifest);
+  if (a.dry_run) {
+    std::cout << batch_summary(records, wall.seconds()) << "manifest (plan only, nothing built): " << manifest << "\n";
     return;
   }
-  for (size_t i = 0; i < shapes.size(); ++i) {
-    std::ostringstream name;
-    name << "avatar_" << std::setw(4) << std::setfill('0') << i + 1 << ".h5";
-    const std::string out = (std::filesystem::path(a.out_dir) / name.str()).string();
-    log_info("shape " + std::to_string(i + 1) + "/" + std::to_string(shapes.size()));
-    PrecomputeReport r = report;
-    r.template_from_cache = true;  // computed once for the batch
-    build_one(model, tv, shapes[i], o, r, out);
+
+  if (pending > 0) {
+    require(jobs == 1 || !o.cache_dir.empty(),
+            "--no-cache with --jobs ", jobs, ": the worker processes share the template stage through the cache; "
+            "give a --cache-dir instead (or --jobs 1)");
+    // The template stage once, before any worker starts: they all load it.
+    PrecomputeReport report;
+    const TemplateVolume tv = cached_template_volume(model, o, &report);
+    if (!report.template_from_cache && a.task_index >= 0)
+      log_info("batch: note: the template stage was not in the cache and was built by this task; with parallel "
+               "tasks run `sflsh precompute --template-only` with the same options first, so they share one build");
+    int done = 0, failed = 0;
+    Timer timer;
+    auto on_done = [&](const BatchRecord& r) {
+      ++done;
+      if (r.status == "failed") {
+        ++failed;
+        report_failure(r);
+      }
+      log_info(batch_progress_line(done, pending, failed, timer.seconds()));
+      write_batch_manifest(records, manifest);
+    };
+    if (jobs == 1) {
+      for (BatchRecord& r : records)
+        if (r.status == "pending") {
+          r = precompute_batch_row(r, shapes[r.row], tv, model, o);
+          on_done(r);
+        }
+    } else {
+      run_in_workers(a, o, jobs, records, on_done);
+    }
   }
+  write_batch_manifest(records, manifest);
+  int failed = 0;
+  for (const BatchRecord& r : records) failed += r.status == "failed";
+  std::cout << batch_summary(records, wall.seconds()) << "manifest: " << manifest << "\n";
+  if (failed > 0)
+    fail("batch: ", failed, " of ", records.size(), " rows failed (table above; manifest ", manifest, ")");
+}
+
+void run_precompute(const PrecomputeArgs& a) {
+  const PrecomputeOptions o = make_options(a);
+  if (!a.batch.empty() && !a.template_only) return run_batch(a, o);
+  require(a.out_dir.empty(), "--out-dir needs --batch");
+  for (const auto& [flag, set] : {std::pair<const char*, bool>{"--jobs", a.jobs != 0}, {"--task-index", a.task_index >= 0},
+                                  {"--shard", !a.shard.empty()}, {"--manifest", !a.manifest.empty()},
+                                  {"--dry-run", a.dry_run}})
+    require(!set || !a.batch.empty(), flag, " needs --batch");
+  const VecX betas = a.betas.empty() ? VecX() : parse_betas(a.betas);
+  const BodyModel model = load_body_model(a.model);
+  require(betas.size() <= model.num_betas(), "betas have ", betas.size(), " entries but the model has ",
+          model.num_betas(), " shape directions");
+  PrecomputeReport report;
+  const TemplateVolume tv = cached_template_volume(model, o, &report);
+  if (a.template_only) {
+    require(!o.cache_dir.empty(), "--template-only writes the template stage to the cache: drop --no-cache");
+    std::cout << "template stage " << (report.template_from_cache ? "already in the cache: " : "built and cached: ")
+              << report.template_cache_path << "\n";
+    return;
+  }
+  build_one(model, tv, betas, o, report, a.out);
 }
 
 const CommandRegistrar reg(20, [](CLI::App& app) {
@@ -122,8 +267,21 @@ const CommandRegistrar reg(20, [](CLI::App& app) {
   cmd->add_option("--handles-file", a->handles_file, "Handle positions, one 'x y z' per line (metres, unposed)");
   cmd->add_option("--thickness-map", a->thickness_map, "Skin thickness scale per body region ('region scale' per line)");
   cmd->add_option("--out", a->out, "Output avatar file")->capture_default_str();
-  cmd->add_option("--batch", a->batch, "CSV of shapes, one β vector per line (header allowed)");
-  cmd->add_option("--out-dir", a->out_dir, "Output folder for --batch (avatar_0001.h5, ... by data row)");
+  cmd->add_option("--batch", a->batch,
+                  "CSV of shapes, one β vector per line; an optional header, whose 'name' column labels the rows");
+  cmd->add_option("--out-dir", a->out_dir,
+                  "Output folder for --batch: avatar-<content key>.h5 per row, manifest.csv maps rows to files");
+  cmd->add_option("--jobs", a->jobs, "--batch: worker processes (default 0 = all cores; 1 = in this process)")
+      ->capture_default_str();
+  cmd->add_option("--task-index", a->task_index, "--batch: build only data row i (0-based; for job arrays)");
+  cmd->add_option("--shard", a->shard, "--batch: build only rows r with r % n == i, given as i/n");
+  cmd->add_option("--manifest", a->manifest,
+                  "--batch: manifest CSV (default <out-dir>/manifest.csv, manifest-shard-i-of-n.csv, "
+                  "manifest-task-i.csv)");
+  cmd->add_flag("--dry-run", a->dry_run,
+                "--batch: only write the manifest (rows pending, exists, duplicate or failed) and build nothing");
+  cmd->add_flag("--template-only", a->template_only,
+                "Only build (or find) the template stage in the cache, e.g. before starting parallel tasks");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder (default: $SFLSH_CACHE_DIR or ~/.cache/sflsh)");
   cmd->add_flag("--no-cache", a->no_cache, "Do not read or write the template-stage cache");
   cmd->add_option("--cell-size", a->cell_size, "Tet size bound (m, Mesh_3 cell_size; smaller = more tets)");

@@ -30,6 +30,15 @@ struct Handle {
   Handle& operator=(const Handle&) = delete;
 };
 
+// Creation property list of `cls` (H5P_DATASET_CREATE, H5P_GROUP_CREATE) that
+// stores no modification times: the same data gives the same bytes, so a
+// rerun's file is bit-identical to the first (batch resume relies on it).
+hid_t untimed(hid_t cls) {
+  const hid_t p = H5Pcreate(cls);
+  H5Pset_obj_track_times(p, false);
+  return p;
+}
+
 std::string shape_str(const std::vector<std::int64_t>& s) {
   std::ostringstream os;
   os << "(";
@@ -116,7 +125,8 @@ void Hdf5File::ensure_parent_groups(const std::string& name) {
   while ((pos = name.find('/', pos + 1)) != std::string::npos) {
     std::string g = name.substr(0, pos);
     if (H5Lexists(file_, g.c_str(), H5P_DEFAULT) <= 0) {
-      hid_t gid = H5Gcreate2(file_, g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      Handle gcpl(untimed(H5P_GROUP_CREATE), H5Pclose);
+      hid_t gid = H5Gcreate2(file_, g.c_str(), H5P_DEFAULT, gcpl.id, H5P_DEFAULT);
       if (gid < 0) fail(path_, ": cannot create group ", g);
       H5Gclose(gid);
     }
@@ -129,7 +139,7 @@ void write_raw(hid_t file, const std::string& path, const std::string& name, con
   std::vector<hsize_t> dims(shape.begin(), shape.end());
   Handle sp(H5Screate_simple(int(dims.size()), dims.data(), nullptr), H5Sclose);
   // Compress large datasets (chunked, deflate level 4): avatars carry big matrices.
-  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  Handle dcpl(untimed(H5P_DATASET_CREATE), H5Pclose);
   hsize_t total = 1;
   for (auto d : dims) total *= d;
   if (total >= 4096 && !dims.empty()) {
@@ -184,7 +194,7 @@ void Hdf5File::create_appendable(const std::string& name, const std::vector<std:
   // Several rows per chunk when rows are small (scalars per frame).
   chunk[0] = std::max<hsize_t>(1, 16384 / row);
   Handle sp(H5Screate_simple(int(dims.size()), dims.data(), maxdims.data()), H5Sclose);
-  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  Handle dcpl(untimed(H5P_DATASET_CREATE), H5Pclose);
   H5Pset_chunk(dcpl.id, int(chunk.size()), chunk.data());
   // Streamed while simulating: byte shuffle + fast deflate (level 1) compresses
   // float frames about as well as level 4 at a fraction of the time.
@@ -235,7 +245,8 @@ void Hdf5File::write_strings(const std::string& name, const std::vector<std::str
   for (auto& v : values) ptrs.push_back(v.c_str());
   hsize_t n = values.size();
   Handle sp(H5Screate_simple(1, &n, nullptr), H5Sclose);
-  Handle ds(H5Dcreate2(file_, name.c_str(), type.id, sp.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  Handle dcpl(untimed(H5P_DATASET_CREATE), H5Pclose);
+  Handle ds(H5Dcreate2(file_, name.c_str(), type.id, sp.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), H5Dclose);
   if (ds.id < 0) fail(path_, ": cannot create dataset ", name);
   if (n > 0 && H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) < 0)
     fail(path_, ": cannot write dataset ", name);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/child_processes.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/fnv_hash.hpp"
 #include "sflsh/core/memory.hpp"
@@ -16,11 +17,8 @@
 #include "sflsh/core/timer.hpp"
 
 namespace sflsh {
-namespace {
 
-// A cache entry depends on the model and on every option that changes the
-// template stage: hash their printed values together with the model hash.
-std::string template_key(const BodyModel& model, const TemplateOptions& o) {
+std::string template_cache_key(const BodyModel& model, const TemplateOptions& o) {
   std::ostringstream s;
   s << std::setprecision(17) << body_model_hash(model) << '|' << kTemplateVolumeFormatVersion << '|' << o.inner_depth
     << '|' << o.skinned_weight_threshold << '|' << o.correspondence.candidate_weight_fraction << '|'
@@ -34,6 +32,8 @@ std::string template_key(const BodyModel& model, const TemplateOptions& o) {
   h.add(s.str());
   return h.hex();
 }
+
+namespace {
 
 // Skin thickness at each node: distance to its skeleton point (handles go
 // where the flesh is thick: belly, buttocks, thighs, ...).
@@ -78,7 +78,7 @@ TemplateVolume cached_template_volume(const BodyModel& model, const PrecomputeOp
   Timer timer;
   std::string path;
   if (!options.cache_dir.empty()) {
-    path = (std::filesystem::path(options.cache_dir) / ("template-" + template_key(model, options.template_stage) + ".h5"))
+    path = (std::filesystem::path(options.cache_dir) / ("template-" + template_cache_key(model, options.template_stage) + ".h5"))
                .string();
     if (report) report->template_cache_path = path;
     if (std::filesystem::exists(path)) {
@@ -103,7 +103,12 @@ TemplateVolume cached_template_volume(const BodyModel& model, const PrecomputeOp
     std::error_code ec;
     std::filesystem::create_directories(options.cache_dir, ec);
     if (ec) fail("cannot create cache folder ", options.cache_dir, ": ", ec.message());
-    save_template_volume(tv, path);
+    // Parallel jobs may build the same entry at once: each writes a name of
+    // its own and renames it into place (atomic; identical contents).
+    const std::string mine = path + "." + process_tag() + ".tmp";
+    save_template_volume(tv, mine);
+    std::filesystem::rename(mine, path, ec);
+    if (ec) fail("cannot move ", mine, " to ", path, ": ", ec.message());
   }
   if (report) {
     report->template_report = tv.report;

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/precompute/batch_precompute.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
@@ -124,9 +125,14 @@ void PipelineCli::BatchPrecomputesOneFilePerRow() {
                                   dir_->file("betas.csv") + " --out-dir " + dir_->file("batch"),
                               &code);
   ASSERT_EQ(code, 0) << out;
-  for (const char* name : {"avatar_0001.h5", "avatar_0002.h5", "avatar_0003.h5"})
-    EXPECT_TRUE(std::filesystem::exists(dir_->file(std::string("batch/") + name))) << name;
-  EXPECT_NEAR(read_avatar(dir_->file("batch/avatar_0002.h5")).betas[1], 0.5, 1e-12);
+  // Files are named by content key; the manifest maps data rows to them.
+  const auto rows = read_batch_manifest(dir_->file("batch/manifest.csv"));
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.status, "built") << r.error;
+    EXPECT_TRUE(std::filesystem::exists(r.file)) << r.file;
+  }
+  EXPECT_NEAR(read_avatar(rows[1].file).betas[1], 0.5, 1e-12);
 }
 
 void PipelineCli::BadInputFailsWithOneClearLineAndNoOutput() {

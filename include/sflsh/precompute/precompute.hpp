@@ -60,8 +60,13 @@ struct PrecomputeReport {
 /// Default cache folder: $SFLSH_CACHE_DIR, else $XDG_CACHE_HOME/sflsh, else ~/.cache/sflsh.
 std::string default_cache_dir();
 
+/// Cache key of the template stage (16 hex digits, FNV-1a): the model hash,
+/// the cache format version and every TemplateOptions value.
+std::string template_cache_key(const BodyModel& model, const TemplateOptions& options);
+
 /// The template stage, from the cache when an entry for (model hash, template
-/// options) exists, else built and stored there.
+/// options) exists, else built and stored there (under a name unique to this
+/// process, then renamed, so concurrent builders never mix their writes).
 TemplateVolume cached_template_volume(const BodyModel& model, const PrecomputeOptions& options,
                                       PrecomputeReport* report = nullptr);
 

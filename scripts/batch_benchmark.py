@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""Batch precompute benchmark (README "Batch precompute"): N shapes of the default
+procedural body built four ways, each into an empty folder, the template stage
+cached once beforehand:
+  serial   sflsh precompute --batch --jobs 1   (in one process, the existing loop)
+  jobs2    sflsh precompute --batch --jobs 2   (2 worker processes)
+  dask1    data_tools/batch_precompute_dask.py, LocalCluster of 1 worker
+  dask2    the same with 2 workers
+Writes scripts/results/batch_benchmark.csv (one line per way), the manifests
+(batch_manifest_<way>.csv) and batch_benchmark.md. Also checks that the four
+ways wrote bit-identical files and that the template cache entry was not rebuilt.
+
+Usage: /usr/bin/python3 scripts/batch_benchmark.py [--sflsh build/sflsh] [--shapes 16] [--handles 16]
+"""
+import argparse
+import csv
+import filecmp
+import os
+import random
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def children_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def load():
+    with open("/proc/loadavg") as f:
+        return float(f.read().split()[0])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sflsh", default=os.path.join(ROOT, "build", "sflsh"))
+    ap.add_argument("--shapes", type=int, default=16)
+    ap.add_argument("--handles", type=int, default=16)
+    ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results"))
+    ap.add_argument("--ways", default="serial,jobs2,dask1,dask2")
+    ap.add_argument("--suffix", default="", help="appended to the result file names (e.g. _omp1)")
+    args = ap.parse_args()
+    sflsh = os.path.abspath(args.sflsh)
+    opts = ["--handles", str(args.handles)]
+    work = tempfile.mkdtemp(prefix="sflsh-batch-bench-")
+    shapes = os.path.join(work, "shapes.csv")
+    rng = random.Random(14)
+    with open(shapes, "w") as f:
+        f.write("name," + ",".join("b%d" % i for i in range(10)) + "\n")
+        for i in range(args.shapes):
+            f.write("s%02d," % i + ",".join("%.3f" % rng.uniform(-2, 2) for _ in range(10)) + "\n")
+    t = subprocess.run([sflsh, "-q", "precompute", "--template-only"] + opts, capture_output=True, text=True, check=True)
+    cache = t.stdout.strip().split(": ", 1)[1]
+    cache_mtime = os.stat(cache).st_mtime_ns
+    print("template stage:", t.stdout.strip(), file=sys.stderr)
+
+    rows = []
+    dirs = {}
+    for way in args.ways.split(","):
+        out_dir = os.path.join(work, way)
+        if way in ("serial", "jobs2"):
+            cmd = [sflsh, "-q", "precompute"] + opts + ["--batch", shapes, "--out-dir", out_dir,
+                                                        "--jobs", "1" if way == "serial" else "2"]
+            manifest = os.path.join(out_dir, "manifest.csv")
+        else:
+            cmd = ["/usr/bin/python3", os.path.join(ROOT, "data_tools", "batch_precompute_dask.py"), "--sflsh", sflsh,
+                   "--workers", way[-1], "--batch", shapes, "--out-dir", out_dir, "--"] + opts
+            manifest = os.path.join(out_dir, "dask_manifest.csv")
+        load_before = load()
+        cpu0, t0 = children_cpu(), time.perf_counter()
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        wall, cpu = time.perf_counter() - t0, children_cpu() - cpu0
+        if p.returncode != 0:
+            sys.exit("%s failed:\n%s%s" % (way, p.stdout, p.stderr))
+        with open(manifest) as f:
+            m = list(csv.DictReader(f))
+        built = [r for r in m if r["status"] == "built"]
+        assert len(built) == args.shapes, (way, len(built))
+        dirs[way] = out_dir
+        summary = [l for l in p.stdout.splitlines() if l.startswith("summary:") or l.startswith("batch summary:")]
+        row = {"way": way, "shapes": args.shapes, "handles": args.handles, "wall_s": round(wall, 2),
+               "wall_per_shape_s": round(wall / args.shapes, 2), "cpu_s": round(cpu, 2),
+               "row_seconds_mean": round(sum(float(r["seconds"]) for r in built) / len(built), 2),
+               "peak_rss_mib_max": max(float(r["peak_rss_mib"]) for r in built),
+               "load_before": load_before, "load_after": load(), "summary": summary[0] if summary else ""}
+        if way.startswith("dask"):
+            row["shape_seconds_mean"] = round(sum(float(r["shape_seconds"]) for r in built) / len(built), 2)
+        rows.append(row)
+        shutil.copy(manifest, os.path.join(args.out, "batch_manifest_%s%s.csv" % (way, args.suffix)))
+        print(row, file=sys.stderr)
+
+    rebuilt = os.stat(cache).st_mtime_ns != cache_mtime
+    base = rows[0]["way"]
+    names = sorted(n for n in os.listdir(dirs[base]) if n.endswith(".h5"))
+    identical = all(filecmp.cmp(os.path.join(dirs[base], n), os.path.join(dirs[w], n), shallow=False)
+                    for w in dirs for n in names)
+    by = {r["way"]: r for r in rows}
+    for r in rows:
+        ref = by.get("serial", r) if r["way"] in ("serial", "jobs2") else by.get("dask1", r)
+        r["speedup"] = round(ref["wall_s"] / r["wall_s"], 2)
+    fields = ["way", "shapes", "handles", "wall_s", "wall_per_shape_s", "cpu_s", "row_seconds_mean",
+              "shape_seconds_mean", "peak_rss_mib_max", "speedup", "load_before", "load_after", "summary"]
+    with open(os.path.join(args.out, "batch_benchmark%s.csv" % args.suffix), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    with open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix), "w") as f:
+        f.write("# Batch precompute benchmark\n\n")
+        f.write("`%s/usr/bin/python3 scripts/batch_benchmark.py --shapes %d --handles %d%s` on %s, %d cores "
+                "(shared with other users' builds: load average %.1f-%.1f during the runs, so wall times are noisy).\n\n"
+                % ("OMP_NUM_THREADS=%s " % os.environ["OMP_NUM_THREADS"] if "OMP_NUM_THREADS" in os.environ else "",
+                   args.shapes, args.handles, " --ways %s --suffix %s" % (args.ways, args.suffix) if args.suffix else "",
+                   os.uname().nodename, os.cpu_count(),
+                   min(r["load_before"] for r in rows), max(r["load_after"] for r in rows)))
+        f.write("| way | wall (s) | wall per shape (s) | CPU (s) | row time, mean (s) | peak RSS per worker (MiB) "
+                "| speed-up |\n|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            ref = "serial" if r["way"] in ("serial", "jobs2") else "dask1"
+            f.write("| %s | %.1f | %.2f | %.1f | %.2f | %.0f | %.2f× (vs %s) |\n"
+                    % (r["way"], r["wall_s"], r["wall_per_shape_s"], r["cpu_s"], r["row_seconds_mean"],
+                       r["peak_rss_mib_max"], r["speedup"], ref))
+        f.write("\nTemplate stage computed once (cache entry %s %s during the runs); the %d ways wrote %s files.\n"
+                % (os.path.basename(cache), "REBUILT" if rebuilt else "not rewritten", len(rows),
+                   "bit-identical" if identical else "DIFFERENT"))
+        for r in rows:
+            if r["summary"]:
+                f.write("\n%s: `%s`\n" % (r["way"], r["summary"]))
+    shutil.rmtree(work, ignore_errors=True)
+    print(open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix)).read())
+
+
+if __name__ == "__main__":
+    main()
