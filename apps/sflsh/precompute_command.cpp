@@ -12,6 +12,7 @@
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -80,11 +81,10 @@ void run_precompute(const PrecomputeArgs& a) {
   if (!a.batch.empty()) {
     require(!a.out_dir.empty(), "--batch needs --out-dir");
     require(a.betas.empty(), "--batch and --betas exclude each other");
+    io::check_output_folder(a.out_dir, "--out-dir");
     shapes = read_betas_csv(a.batch);
-    std::error_code ec;
-    std::filesystem::create_directories(a.out_dir, ec);
-    if (ec) fail(a.out_dir, ": cannot create output folder: ", ec.message());
   } else {
+    io::check_output_file(a.out, "--out");
     shapes.push_back(a.betas.empty() ? VecX() : parse_betas(a.betas));
   }
   const BodyModel model = load_body_model(a.model);
