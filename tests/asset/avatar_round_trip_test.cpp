@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 
 #include <Eigen/Geometry>
 
@@ -183,4 +184,30 @@ TEST(AvatarRoundTrip, InertiaCubatureOfTheReadFileCarriesTheMeshMass) {
   for (int s = 0; s < b.inertia.size(); ++s)
     cubature_mass += b.materials[b.tet_region[b.inertia.elements[s]]].density * b.inertia.weights[s];
   EXPECT_NEAR(cubature_mass, mesh_mass, 1e-12 * mesh_mass);
+}
+
+TEST(AvatarRoundTrip, ValidationRejectsEveryIndexOneBeyondItsRange) {
+  // Each index set exactly to its bound (one past the last valid value).
+  const Avatar ok = distinct_avatar();
+  const int N = int(ok.tet.nodes.rows()), T = int(ok.tet.elements.rows()), V = int(ok.surface_rest.rows());
+  const int R = int(ok.materials.size());
+  struct Case {
+    const char* dataset;
+    std::function<void(Avatar&)> edit;
+  } cases[] = {
+      {"/tet/region", [&](Avatar& a) { a.tet_region[3] = R; }},
+      {"/tet/elements", [&](Avatar& a) { a.tet.elements(2, 1) = N; }},
+      {"/surface/tet", [&](Avatar& a) { a.surface_tet[4] = T; }},
+      {"/surface/faces", [&](Avatar& a) { a.surface_faces(1, 2) = V; }},
+      {"/tet/surface_nodes", [&](Avatar& a) { a.surface_nodes[0] = N; }},
+      {"/tet/node_role", [&](Avatar& a) { a.node_role[5] = 3; }},
+      {"/cubature/elastic", [&](Avatar& a) { a.elastic.elements[1] = T; }},
+      {"/cubature/inertia", [&](Avatar& a) { a.inertia.elements[0] = T; }},
+  };
+  for (const auto& c : cases) {
+    Avatar a = ok;
+    c.edit(a);
+    test::expect_error([&] { validate_avatar(a, "x.h5"); }, {"x.h5", c.dataset});
+  }
+  EXPECT_NO_THROW(validate_avatar(ok, "ok.h5"));
 }
