@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libcli11-dev libyaml-cpp-dev libzip-dev zlib1g-dev
   libtbb-dev libpng-dev
   python3-numpy python3-scipy python3-h5py
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer, ASan, UBSan
 )
 
 missing=()
