@@ -4,9 +4,8 @@
 # Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5.
 # Needs clang and compiler-rt (Debian: clang libclang-rt-14-dev; scripts/setup.sh).
 #
-# Builds into build-fuzz/ (only the sources the readers need; the simulation
-# loop that shares a file with the result reader is never called, so its
-# unresolved symbols are ignored at link time), seeds each corpus with valid files
+# Builds into build-fuzz/ (the reader sources, instrumented; the rest from the
+# normal build's libraries, which it builds if needed), seeds each corpus with valid files
 # made from the project's own test data (test_fuzz with SFLSH_FUZZ_SEED_DIR,
 # from the normal build) plus tests/fuzz_regressions/<target>/, and runs each
 # target for SECONDS with a 10 s per-input timeout, a 2 GB RSS limit and a
@@ -42,24 +41,28 @@ OBJS=()
 cd "$ROOT"
 for src in "${SOURCES[@]}"; do
   obj="$OUT/obj/$(echo "$src" | tr / _).o"
-  # ccache makes unchanged sources cheap; without it, rebuild when the source is newer.
-  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || command -v ccache >/dev/null; then
+  # Rebuild when the source, or any project header, is newer than the object.
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find include fuzz -name '*.hpp' -newer "$obj" | head -1)" ]; then
     $CXX "${FLAGS[@]}" -fsanitize=fuzzer-no-link "${EIGEN[@]}" "${HDF5_CFLAGS[@]}" -c "$src" -o "$obj"
   fi
   OBJS+=("$obj")
 done
+# The result reader shares its file with the simulation loop, which the fuzz
+# targets never call: its symbols come, uninstrumented, from the normal build's
+# libraries, linked after (and never instead of) the instrumented objects.
+BUILD="${SFLSH_BUILD_DIR:-build}"
+if [ ! -x "$BUILD/test_fuzz" ]; then
+  SFLSH_JOBS="${SFLSH_JOBS:-2}" bash scripts/build.sh --target test_fuzz > "$OUT/normal_build.log" 2>&1 ||
+    { tail -20 "$OUT/normal_build.log"; exit 1; }
+fi
+NORMAL_LIBS=()
+for m in scene sim motion asset basis volume body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
 for t in "${TARGETS[@]}"; do
   $CXX "${FLAGS[@]}" -fsanitize=fuzzer -DSFLSH_FUZZ_TARGET="$t" "${EIGEN[@]}" fuzz/fuzz_main.cpp "${OBJS[@]}" \
-    -Wl,--gc-sections -Wl,--unresolved-symbols=ignore-in-object-files "${LIBS[@]}" -o "$OUT/${t}_fuzz"
+    -Wl,--gc-sections -Wl,--allow-multiple-definition "${NORMAL_LIBS[@]}" "${LIBS[@]}" \
+    -lcholmod -lsuitesparseconfig -ltbb -lpng -lassimp -lyaml-cpp -lgmp -lmpfr -o "$OUT/${t}_fuzz"
 done
-
-[ "${FUZZ_BUILD_ONLY:-0}" = 1 ] && { echo "built ${TARGETS[*]}"; exit 0; }
-
 echo "making seed files from the project's test data ..."
-if [ ! -x "${SFLSH_BUILD_DIR:-build}/test_fuzz" ]; then
-  SFLSH_JOBS="${SFLSH_JOBS:-2}" bash scripts/build.sh --target test_fuzz > "$OUT/seed_build.log" 2>&1 ||
-    { tail -20 "$OUT/seed_build.log"; exit 1; }
-fi
 rm -rf "$OUT/seeds"
 SFLSH_FUZZ_SEED_DIR="$OUT/seeds" "${SFLSH_BUILD_DIR:-build}/test_fuzz" \
   --gtest_filter=FuzzReplay.ValidAndMutatedProjectFiles > "$OUT/seeds.log" 2>&1 || { cat "$OUT/seeds.log"; exit 1; }
