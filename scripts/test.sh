@@ -24,12 +24,12 @@ if [ "$SANITIZE" != 1 ]; then
   exit 0
 fi
 
-# Heavy under the sanitizers: meshing the body (CGAL), the precompute pipeline
-# and file-betas builds, and the procedural-body checks over the shape space
-# (minutes at -O1 with ASan on 2 cores); and the timing assertions, which are
-# meaningless under ASan. Chosen by what the tests do; see the report of the
-# branch `reliability` for what was measured.
-SANITIZE_EXCLUDE='^(PipelineCli|FileBetas|TemplateVolume|ShapeVolume|ProceduralBody|PelvisTracking)\.'
+# Heavy under the sanitizers: meshing the body (CGAL), the precompute pipeline,
+# file-betas builds and long tracking runs (minutes at -O1 with ASan on 2
+# cores; chosen by what the tests do, not yet timed under ASan), and the timing
+# assertions, which are meaningless under ASan. Measured under ASan: test_core
+# 0.2 s, test_io 2.9 s, test_body 67 s (all pass).
+SANITIZE_EXCLUDE='^(PipelineCli|FileBetas|TemplateVolume|ShapeVolume|PelvisTracking)\.'
 SANITIZE_EXCLUDE+='|^(Simulator\.StepTimeAtSixtyFourHandles|BodyModel\.PosingTenThousandVerticesIsFast|BvhParser\.TenThousandFramesParseTime)$'
 DIR="${SFLSH_ASAN_BUILD_DIR:-build-asan}"
 SAN="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined"
