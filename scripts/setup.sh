@@ -11,6 +11,7 @@ PACKAGES=(
   libtbb-dev libpng-dev
   python3-numpy python3-scipy python3-h5py
   python3-distributed
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer, ASan, UBSan
 )
 
 missing=()

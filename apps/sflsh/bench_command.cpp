@@ -1,6 +1,7 @@
 // `sflsh bench`: run time against error versus the full-FEM reference.
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include "command.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/bench/benchmark.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -17,6 +19,7 @@ struct BenchArgs {
   bool quick = false, no_cache = false;
   std::string motion = "builtin:jump", out = "bench", model = "procedural", betas, handles, cache_dir;
   double seconds = 0;
+  bool seconds_given = false;
 };
 
 void run_bench(const BenchArgs& a) {
@@ -39,11 +42,14 @@ void run_bench(const BenchArgs& a) {
     }
   }
   if (!a.no_cache) o.precompute.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
-  std::error_code ec;
-  std::filesystem::create_directories(a.out, ec);
-  if (ec) fail(a.out, ": cannot create output folder: ", ec.message());
+  require(!a.seconds_given || (std::isfinite(a.seconds) && a.seconds > 0),
+          "--seconds must be a positive number of seconds, got ", a.seconds);
+  io::check_output_folder(a.out, "--out");
 
   const auto rows = run_benchmark(o);
+  std::error_code ec;  // made only now: a run that fails leaves no empty folder
+  std::filesystem::create_directories(a.out, ec);
+  if (ec) fail("--out ", a.out, ": cannot create output folder: ", ec.message());
   const std::string csv = (std::filesystem::path(a.out) / "bench.csv").string();
   const std::string svg = (std::filesystem::path(a.out) / "bench.svg").string();
   const std::string md = (std::filesystem::path(a.out) / "bench.md").string();
@@ -64,14 +70,17 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "Run time against error: reduced solver vs. full-FEM reference vs. skinning");
   cmd->add_flag("--quick", a->quick, "Fewer variants and 0.5 s of motion");
   cmd->add_option("--motion", a->motion, "Motion (builtin:jump|shake|idle or a file)")->capture_default_str();
-  cmd->add_option("--seconds", a->seconds, "Simulated seconds per variant (default 0.5 quick, 2 full)");
+  auto* seconds = cmd->add_option("--seconds", a->seconds, "Simulated seconds per variant (default 0.5 quick, 2 full)");
   cmd->add_option("--model", a->model, "Body model")->capture_default_str();
   cmd->add_option("--betas", a->betas, "Body shape b0,b1,...");
   cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
   cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.md, bench.svg)")->capture_default_str();
-  cmd->callback([a] { run_bench(*a); });
+  cmd->callback([a, seconds] {
+    a->seconds_given = seconds->count() > 0;
+    run_bench(*a);
+  });
 });
 
 }  // namespace

@@ -200,10 +200,12 @@ void check_joint_path(const std::string& path) {
   const std::string ext = io::lower_extension(path);
   require(ext == ".csv" || ext == ".json", "--joints ", path, ": unknown joint file format '", ext,
           "'; supported: .csv, .json");
+  io::check_output_file(path, "--joints");
 }
 
 void run_export(const BodyArgs& a, const std::string& out, const std::string& joints_out) {
   io::require_mesh_export_extension(out, "--out " + out);
+  io::check_output_file(out, "--out");
   if (!joints_out.empty()) check_joint_path(joints_out);
   const LoadedBody b = load_body(a);
   const PosedBody posed = pose_body(b.model, b.betas, b.pose);
@@ -221,6 +223,7 @@ void run_export(const BodyArgs& a, const std::string& out, const std::string& jo
 
 void run_render(const BodyArgs& a, const std::string& out, int size) {
   require(io::lower_extension(out) == ".png", "--out ", out, ": the picture is written as PNG; use a .png name");
+  io::check_output_file(out, "--out");
   require(size >= 64 && size <= 8192, "--size: expected 64..8192 pixels, got ", size);
   const LoadedBody b = load_body(a);
   const PosedBody posed = pose_body(b.model, b.betas, b.pose);

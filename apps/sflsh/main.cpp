@@ -7,6 +7,7 @@
 
 #include "command.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/progress.hpp"
 
 namespace sflsh::cli {
@@ -35,6 +36,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const sflsh::Interrupted& e) {
+    std::fprintf(stderr, "sflsh: %s\n", e.what());
+    return e.exit_code();
   } catch (const sflsh::Error& e) {
     std::fprintf(stderr, "sflsh: error: %s\n", e.what());
     return 1;

@@ -20,6 +20,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -156,6 +157,7 @@ void run_in_workers(const PrecomputeArgs& a, const PrecomputeOptions& o, int job
 
 void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   require(!a.out_dir.empty(), "--batch needs --out-dir");
+  io::check_output_folder(a.out_dir, "--out-dir");
   require(a.betas.empty(), "--batch and --betas exclude each other");
   require(a.task_index < 0 || a.shard.empty(), "--task-index and --shard exclude each other");
   require(a.jobs >= 0 && a.jobs <= 1024, "--jobs must be in [1, 1024] (or 0 for all cores), got ", a.jobs);
@@ -238,6 +240,7 @@ void run_precompute(const PrecomputeArgs& a) {
                                   {"--shard", !a.shard.empty()}, {"--manifest", !a.manifest.empty()},
                                   {"--dry-run", a.dry_run}})
     require(!set || !a.batch.empty(), flag, " needs --batch");
+  if (!a.template_only) io::check_output_file(a.out, "--out");
   const VecX betas = a.betas.empty() ? VecX() : parse_betas(a.betas);
   const BodyModel model = load_body_model(a.model);
   require(betas.size() <= model.num_betas(), "betas have ", betas.size(), " entries but the model has ",

@@ -8,6 +8,7 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/motion/load_motion.hpp"
@@ -27,6 +28,7 @@ struct SimulateArgs {
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
   bool line_search = false, use_file_betas = false, start_at_rest = false;
+  bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
 };
 
 
@@ -42,18 +44,22 @@ void run_simulate(const SimulateArgs& a) {
   o.sim.newton.max_rotation_step = a.max_rotation_step;
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
+  require(!a.seconds_given || (std::isfinite(a.seconds) && a.seconds > 0),
+          "--seconds must be a positive number of seconds, got ", a.seconds);
+  require(std::isfinite(a.output_fps) && a.output_fps > 0, "--output-fps must be positive, got ", a.output_fps);
+  require(std::isfinite(a.speed) && a.speed > 0, "--speed must be positive, got ", a.speed);
+  require(std::isfinite(a.start) && a.start >= 0, "--start must be >= 0 s, got ", a.start);
+  require(std::isfinite(a.end), "--end must be a number of seconds, got ", a.end);
   o.seconds = a.seconds;
   o.output_fps = a.output_fps;
   o.start_at_rest = a.start_at_rest;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
   // Check every output can be written before spending time simulating.
-  for (const std::string& p : {a.out, a.render, a.checkpoint}) {
-    if (p.empty()) continue;
-    const auto parent = std::filesystem::path(p).parent_path();
-    require(parent.empty() || std::filesystem::is_directory(parent), p, ": output folder ", parent.string(),
-            " does not exist");
-  }
+  io::check_output_file(a.out, "--out");
+  if (!a.render.empty()) io::check_output_file(a.render, "--render");
+  if (!a.exp.empty()) io::check_output_file(a.exp, "--export");
+  if (!a.checkpoint.empty()) io::check_output_file(a.checkpoint, "--checkpoint");
 
   if (a.use_file_betas)
     require(a.motion.rfind("builtin:", 0) != 0 && io::lower_extension(a.motion) == ".npz",
@@ -88,12 +94,26 @@ void run_simulate(const SimulateArgs& a) {
   std::cerr << mrep.describe();
 
   // Frames stream into the result file; exports and the picture read it back.
+  // SIGINT/SIGTERM stop the run between steps; the writer's partial file is
+  // removed as the exception leaves this block.
   o.keep_frames = false;
-  ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
-  SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
-  r.avatar = avatar_name;
-  writer.finish(r);
-  std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
+  {
+    const InterruptScope interrupt_scope;
+    try {
+      ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
+      SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+      r.avatar = avatar_name;
+      throw_if_interrupted("after the last step");
+      writer.finish(r);
+      std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
+    } catch (const Interrupted& e) {
+      const std::string partial = a.out + ".partial";
+      throw Interrupted(std::string(e.what()) + "; " +
+                            (std::filesystem::exists(partial) ? "could not remove " : "removed ") + partial +
+                            ", no result written",
+                        e.signal());
+    }
+  }
   if (!a.exp.empty() || !a.render.empty()) {
     const SimulationResult full = read_simulation_result(a.out);
     if (!a.exp.empty()) std::cout << export_result(full, a.exp) << "\n";
@@ -111,7 +131,7 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--motion", a->motion, "builtin:jump|shake|idle, an AMASS .npz, a .bvh, or FBX/DAE/glTF")
       ->capture_default_str();
   cmd->add_option("--dt", a->dt, "Time step in seconds (e.g. 1/60)")->capture_default_str();
-  cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
+  auto* seconds = cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
   cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
   cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
   cmd->add_option("--max-rotation-step", a->max_rotation_step,
@@ -142,7 +162,10 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
-  cmd->callback([a] { run_simulate(*a); });
+  cmd->callback([a, seconds] {
+    a->seconds_given = seconds->count() > 0;
+    run_simulate(*a);
+  });
 });
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/bench/stress_run.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -22,11 +23,13 @@ void run_stress_command(const StressArgs& a) {
   o.dt = parse_time_step(a.dt);
   o.steps = a.steps;
   require(a.steps >= 1, "--steps must be >= 1, got ", a.steps);
+  io::check_output_folder(a.out, "--out");
   const auto avatar = std::make_shared<const Avatar>(read_avatar(a.avatar));
+  const StressReport r = run_stress(avatar, o);
+  // Made only now, so that a run that fails to start (a missing motion) leaves no empty folder.
   std::error_code ec;
   std::filesystem::create_directories(a.out, ec);
-  if (ec) fail(a.out, ": cannot create output folder: ", ec.message());
-  const StressReport r = run_stress(avatar, o);
+  if (ec) fail("--out ", a.out, ": cannot create output folder: ", ec.message());
   const std::string csv = (std::filesystem::path(a.out) / "stress.csv").string();
   const std::string svg = (std::filesystem::path(a.out) / "stress.svg").string();
   write_stress_csv(r, csv);

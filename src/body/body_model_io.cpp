@@ -74,11 +74,13 @@ class Hdf5Source : public ArraySource {
     const auto nnz = std::int64_t(indices.size());
     if (indptr[0] != 0 || indptr[kSmplJoints] != double(nnz))
       fail(path_, ": dataset /", g, "indptr must start at 0 and end at ", nnz, " (the length of indices)");
+    // The whole sequence first: a row end beyond nnz must not be read from.
+    for (int r = 0; r < kSmplJoints; ++r)
+      if (!(indptr[r + 1] >= indptr[r]) || indptr[r + 1] != std::floor(indptr[r + 1]))
+        fail(path_, ": dataset /", g, "indptr is not a non-decreasing integer sequence at entry ", r + 1);
     std::vector<Eigen::Triplet<double>> trips;
     trips.reserve(nnz);
     for (int r = 0; r < kSmplJoints; ++r) {
-      if (!(indptr[r + 1] >= indptr[r]) || indptr[r] != std::floor(indptr[r]))
-        fail(path_, ": dataset /", g, "indptr is not a non-decreasing integer sequence at entry ", r + 1);
       for (auto k = std::int64_t(indptr[r]); k < std::int64_t(indptr[r + 1]); ++k) {
         if (indices[k] < 0 || indices[k] >= double(V) || indices[k] != std::floor(indices[k]))
           fail(path_, ": dataset /", g, "indices[", k, "] = ", indices[k], ", expected a vertex index in [0, ", V,

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <system_error>
 
+#include <unistd.h>
+
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::io {
@@ -33,6 +35,41 @@ void AtomicOutput::commit() {
   fs::rename(temp_path_, path_, ec);
   if (ec) fail(path_, ": cannot rename ", temp_path_, " into place: ", ec.message());
   committed_ = true;
+}
+
+namespace {
+
+// The nearest existing ancestor of `path` must be a folder we can create files in.
+void check_writable_ancestor(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  fs::path dir = path.parent_path();
+  while (!dir.empty() && !fs::exists(dir, ec)) dir = dir.parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec)) fail(what, ": ", dir.string(), " is not a folder");
+  std::string probe = (dir / ".sflsh-write-check-XXXXXX").string();
+  const int fd = mkstemp(probe.data());
+  if (fd < 0) fail(what, ": cannot create files in folder ", dir.string());
+  close(fd);
+  unlink(probe.c_str());
+}
+
+}  // namespace
+
+void check_output_file(const std::string& path, const std::string& option) {
+  const std::string what = option + " " + path;
+  require(!path.empty(), option, ": output path is empty");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail(what, ": is a folder; give a file name");
+  check_writable_ancestor(fs::path(path), what);
+}
+
+void check_output_folder(const std::string& path, const std::string& option) {
+  const std::string what = option + " " + path;
+  require(!path.empty(), option, ": output folder is empty");
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_directory(path, ec)) fail(what, ": exists and is not a folder");
+  // Probe inside the folder itself when it exists, else in its nearest existing ancestor.
+  check_writable_ancestor(fs::path(path) / "x", what);
 }
 
 std::string lower_extension(const std::string& path) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
@@ -48,18 +50,74 @@ std::string shape_str(const std::vector<std::int64_t>& s) {
   return os.str();
 }
 
+struct MemoryImage {
+  const void* data;
+  std::size_t size;
+};
+std::mutex g_images_mutex;
+std::map<std::string, MemoryImage>& memory_images() {
+  static std::map<std::string, MemoryImage> images;
+  return images;
+}
+
+// Product of `dims`, or UINT64_MAX when it overflows.
+std::uint64_t element_count(const std::vector<std::int64_t>& dims) {
+  std::uint64_t n = 1;
+  for (auto d : dims) {
+    if (d < 0) return UINT64_MAX;
+    if (d != 0 && n > UINT64_MAX / std::uint64_t(d)) return UINT64_MAX;
+    n *= std::uint64_t(d);
+  }
+  return n;
+}
+
 }  // namespace
+
+Hdf5MemoryImage::Hdf5MemoryImage(std::string name, const void* data, std::size_t size) : name_(std::move(name)) {
+  std::lock_guard<std::mutex> lock(g_images_mutex);
+  require(memory_images().emplace(name_, MemoryImage{data, size}).second, name_, ": memory image registered twice");
+}
+
+Hdf5MemoryImage::~Hdf5MemoryImage() {
+  std::lock_guard<std::mutex> lock(g_images_mutex);
+  memory_images().erase(name_);
+}
 
 Hdf5File::Hdf5File(const std::string& path, Mode mode) : path_(path), mode_(mode) {
   if (mode == Mode::Read) {
+    MemoryImage image{nullptr, 0};
+    bool in_memory = false;
+    {
+      std::lock_guard<std::mutex> lock(g_images_mutex);
+      const auto it = memory_images().find(path);
+      if (it != memory_images().end()) image = it->second, in_memory = true;
+    }
+    if (in_memory) {
+      // The core driver reads a copy of the image; nothing touches the disk.
+      file_bytes_ = image.size;
+      if (image.size < 8) fail(path, ": not an HDF5 file (or truncated/corrupted)");
+      Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+      if (H5Pset_fapl_core(fapl.id, 1 << 16, 0) < 0 || H5Pset_file_image(fapl.id, const_cast<void*>(image.data), image.size) < 0)
+        fail(path, ": cannot set up the in-memory HDF5 image");
+      file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.id);
+      if (file_ < 0) fail(path, ": cannot open HDF5 file (truncated or corrupted?)");
+      return;
+    }
     if (!std::filesystem::exists(path)) fail(path, ": file not found");
+    std::error_code ec;
+    file_bytes_ = std::filesystem::file_size(path, ec);
+    if (ec) fail(path, ": not a regular file (", ec.message(), ")");
     if (H5Fis_hdf5(path.c_str()) <= 0) fail(path, ": not an HDF5 file (or truncated/corrupted)");
     file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file_ < 0) fail(path, ": cannot open HDF5 file (truncated or corrupted?)");
   } else {
     write_path_ = path + ".partial";
     auto parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty() && !std::filesystem::exists(parent)) fail(path, ": output folder ", parent.string(), " does not exist");
+    if (!parent.empty()) {  // like AtomicOutput: missing folders are made
+      std::error_code ec;
+      std::filesystem::create_directories(parent, ec);
+      if (ec) fail(path, ": cannot create folder ", parent.string(), ": ", ec.message());
+    }
     file_ = H5Fcreate(write_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file_ < 0) fail(path, ": cannot create file");
   }
@@ -101,6 +159,13 @@ bool Hdf5File::has(const std::string& name) const {
     if (H5Lexists(file_, partial.c_str(), H5P_DEFAULT) <= 0) return false;
   }
   return !partial.empty();
+}
+
+void Hdf5File::check_declared_size(const std::string& name, std::uint64_t count, std::uint64_t bytes_each) const {
+  const std::uint64_t limit = kMaxSmallDataset + kMaxExpansion * file_bytes_;
+  if (count > limit / std::max<std::uint64_t>(bytes_each, 1))
+    fail(path_, ": dataset ", name, " declares ", count, " values, more than a ", file_bytes_,
+         "-byte file can hold (corrupted file?)");
 }
 
 long Hdf5File::open_dataset(const std::string& name) const {
@@ -261,19 +326,23 @@ std::vector<std::string> Hdf5File::read_strings(const std::string& name) const {
   Handle ftype(H5Dget_type(ds.id), H5Tclose);
   if (H5Tget_class(ftype.id) != H5T_STRING) fail(path_, ": dataset ", name, " is not a string dataset");
   Handle sp(H5Dget_space(ds.id), H5Sclose);
-  hssize_t n = H5Sget_simple_extent_npoints(sp.id);
+  const hssize_t n = H5Sget_simple_extent_npoints(sp.id);
+  if (n < 0) fail(path_, ": dataset ", name, " has an unreadable shape");
   std::vector<std::string> out;
   if (H5Tis_variable_str(ftype.id) > 0) {
     Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mtype.id, H5T_VARIABLE);
     H5Tset_cset(mtype.id, H5Tget_cset(ftype.id));  // HDF5 does not convert ASCII <-> UTF-8
+    check_declared_size(name, std::uint64_t(n), sizeof(char*) + sizeof(std::string));
     std::vector<char*> buf(n, nullptr);
     if (n > 0 && H5Dread(ds.id, mtype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
       fail(path_, ": cannot read dataset ", name);
     for (auto* p : buf) out.emplace_back(p ? p : "");
     if (n > 0) H5Dvlen_reclaim(mtype.id, sp.id, H5P_DEFAULT, buf.data());
   } else {
-    size_t sz = H5Tget_size(ftype.id);
+    const size_t sz = H5Tget_size(ftype.id);
+    if (sz == 0) fail(path_, ": dataset ", name, " has strings of size 0");
+    check_declared_size(name, std::uint64_t(n), sz + sizeof(std::string));
     std::vector<char> buf(sz * n + 1, 0);
     if (n > 0 && H5Dread(ds.id, ftype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
       fail(path_, ": cannot read dataset ", name);
@@ -301,8 +370,8 @@ std::vector<double> Hdf5File::read_nd(const std::string& name, const std::vector
   bool ok = expected.empty() || s.size() == expected.size();
   for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] < 0 || expected[i] == s[i];
   if (!ok) fail(path_, ": dataset ", name, " has shape ", shape_str(s), ", expected ", shape_str(expected));
-  std::int64_t n = 1;
-  for (auto d : s) n *= d;
+  check_declared_size(name, element_count(s), sizeof(double));
+  const std::int64_t n = std::int64_t(element_count(s));
   std::vector<double> buf(n);
   if (n > 0 && H5Dread(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
     fail(path_, ": cannot read dataset ", name, " (truncated or corrupted file?)");
@@ -318,7 +387,7 @@ MatXr Hdf5File::read_matrix(const std::string& name, std::int64_t rows, std::int
   if (s.size() != 2) fail(path_, ": dataset ", name, " has rank ", s.size(), ", expected a matrix ", shape_str({rows, cols}));
   if ((rows >= 0 && s[0] != rows) || (cols >= 0 && s[1] != cols))
     fail(path_, ": dataset ", name, " has shape ", shape_str(s), ", expected ", shape_str({rows, cols}));
-  auto buf = read_nd(name, {});
+  auto buf = read_nd(name, {});  // checks the declared size first
   MatXr m(s[0], s[1]);
   std::copy(buf.begin(), buf.end(), m.data());
   return m;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -429,21 +430,27 @@ std::string zip_error_text(int code) {
 }
 
 // Reads entry `index` completely; grows the buffer as data arrives so a lying
-// size field cannot trigger a huge allocation.
-std::string read_zip_entry(zip_t* z, zip_uint64_t index, const std::string& where) {
+// size field cannot trigger a huge allocation, and stops at `max_bytes` (a
+// bound from the archive's size: deflate expands at most ~1032x) so that a
+// small "zip bomb" cannot fill the memory either.
+std::string read_zip_entry(zip_t* z, zip_uint64_t index, const std::string& where, std::uint64_t max_bytes) {
   zip_file_t* f = zip_fopen_index(z, index, 0);
   if (!f) fail(where, ": cannot open the entry: ", zip_strerror(z));
   std::string buf;
-  char chunk[1 << 16];
+  std::vector<char> chunk(1 << 16);
   while (true) {
-    const zip_int64_t got = zip_fread(f, chunk, sizeof(chunk));
+    const zip_int64_t got = zip_fread(f, chunk.data(), chunk.size());
     if (got < 0) {
       const std::string msg = zip_file_strerror(f);
       zip_fclose(f);
       fail(where, ": cannot read the entry (truncated or corrupt archive): ", msg);
     }
     if (got == 0) break;
-    buf.append(chunk, size_t(got));
+    if (buf.size() + std::uint64_t(got) > max_bytes) {
+      zip_fclose(f);
+      fail(where, ": the entry expands beyond ", max_bytes, " bytes, more than its archive can hold (corrupt archive?)");
+    }
+    buf.append(chunk.data(), size_t(got));
   }
   // zip_fclose reports CRC mismatches of the data just read.
   const int rc = zip_fclose(f);
@@ -458,13 +465,12 @@ std::string key_of(const std::string& entry_name) {
   return entry_name;
 }
 
-// Calls fn(key, parsed) for every .npy entry of the archive.
+// Largest entry accepted from an archive of `archive_bytes` bytes.
+std::uint64_t max_entry_bytes(std::uint64_t archive_bytes) { return (std::uint64_t(16) << 20) + 1100 * archive_bytes; }
+
+// Calls fn(key, parsed) for every .npy entry of the open archive `z` (discarded here).
 template <class Fn>
-void for_each_npz_entry(const std::string& path, Fn fn) {
-  if (!std::filesystem::exists(path)) fail(path, ": file not found");
-  int err = 0;
-  zip_t* z = zip_open(path.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &err);
-  if (!z) fail(path, ": not a readable .npz (zip) archive (truncated or corrupt?): ", zip_error_text(err));
+void for_each_entry(zip_t* z, const std::string& path, std::uint64_t archive_bytes, Fn fn) {
   struct Closer {
     zip_t* z;
     ~Closer() { zip_discard(z); }
@@ -475,8 +481,59 @@ void for_each_npz_entry(const std::string& path, Fn fn) {
     if (!name) fail(path, ": cannot read the name of archive entry ", i);
     const std::string key = key_of(name);
     const std::string where = path + ": key '" + key + "'";
-    fn(key, parse_npy(read_zip_entry(z, zip_uint64_t(i), where), where));
+    fn(key, parse_npy(read_zip_entry(z, zip_uint64_t(i), where, max_entry_bytes(archive_bytes)), where));
   }
+}
+
+template <class Fn>
+void for_each_npz_entry(const std::string& path, Fn fn) {
+  if (!std::filesystem::exists(path)) fail(path, ": file not found");
+  std::error_code ec;
+  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, ": not a regular file (", ec.message(), ")");
+  int err = 0;
+  zip_t* z = zip_open(path.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &err);
+  if (!z) fail(path, ": not a readable .npz (zip) archive (truncated or corrupt?): ", zip_error_text(err));
+  for_each_entry(z, path, bytes, fn);
+}
+
+template <class Fn>
+void for_each_npz_entry_in_memory(const std::string& bytes, const std::string& name, Fn fn) {
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* src = zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error);
+  if (!src) {
+    zip_error_fini(&error);
+    fail(name, ": cannot read the archive from memory");
+  }
+  zip_t* z = zip_open_from_source(src, ZIP_RDONLY | ZIP_CHECKCONS, &error);
+  if (!z) {
+    const std::string msg = zip_error_strerror(&error);
+    zip_source_free(src);
+    zip_error_fini(&error);
+    fail(name, ": not a readable .npz (zip) archive (truncated or corrupt?): ", msg);
+  }
+  zip_error_fini(&error);
+  for_each_entry(z, name, bytes.size(), fn);
+}
+
+std::map<std::string, NpyArray> collect_arrays(
+    const std::function<void(const std::function<void(const std::string&, ParsedNpy)>&)>& each,
+    std::map<std::string, std::vector<std::string>>* strings) {
+  std::map<std::string, NpyArray> arrays;
+  each([&](const std::string& key, ParsedNpy p) {
+    if (p.kind == ParsedNpy::Kind::Numeric)
+      arrays[key] = std::move(p.array);
+    else if (p.kind == ParsedNpy::Kind::Text && strings)
+      (*strings)[key] = std::move(p.strings);
+  });
+  return arrays;
+}
+
+NpyArray numeric_array(ParsedNpy p, const std::string& where) {
+  if (p.kind != ParsedNpy::Kind::Numeric)
+    fail(where, ": dtype '", p.array.dtype, "' is not numeric (expected float, int or bool data)");
+  return std::move(p.array);
 }
 
 }  // namespace
@@ -518,14 +575,12 @@ void NpyArray::require_finite(const std::string& where, const std::string& key) 
 
 std::map<std::string, NpyArray> read_npz(const std::string& path,
                                          std::map<std::string, std::vector<std::string>>* strings) {
-  std::map<std::string, NpyArray> arrays;
-  for_each_npz_entry(path, [&](const std::string& key, ParsedNpy p) {
-    if (p.kind == ParsedNpy::Kind::Numeric)
-      arrays[key] = std::move(p.array);
-    else if (p.kind == ParsedNpy::Kind::Text && strings)
-      (*strings)[key] = std::move(p.strings);
-  });
-  return arrays;
+  return collect_arrays([&](const auto& fn) { for_each_npz_entry(path, fn); }, strings);
+}
+
+std::map<std::string, NpyArray> read_npz_bytes(const std::string& bytes, const std::string& name,
+                                               std::map<std::string, std::vector<std::string>>* strings) {
+  return collect_arrays([&](const auto& fn) { for_each_npz_entry_in_memory(bytes, name, fn); }, strings);
 }
 
 std::vector<NpzEntryInfo> list_npz(const std::string& path) {
@@ -541,10 +596,11 @@ NpyArray read_npy(const std::string& path) {
   if (!in) fail(path, ": cannot open file");
   std::ostringstream ss;
   ss << in.rdbuf();
-  ParsedNpy p = parse_npy(ss.str(), path);
-  if (p.kind != ParsedNpy::Kind::Numeric)
-    fail(path, ": dtype '", p.array.dtype, "' is not numeric (expected float, int or bool data)");
-  return std::move(p.array);
+  return numeric_array(parse_npy(ss.str(), path), path);
+}
+
+NpyArray read_npy_bytes(const std::string& bytes, const std::string& name) {
+  return numeric_array(parse_npy(bytes, name), name);
 }
 
 void write_npz(const std::string& path, const std::map<std::string, NpyArray>& arrays, bool compressed) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/sim/skeleton_pose.hpp"
@@ -145,6 +146,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
   int steps_since_frame = 0;
   Progress progress("simulating " + motion.name, steps);
   for (long s = first_step; s < steps; ++s) {
+    if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(s + 1) + " of " + std::to_string(steps));
     const double t = (s + 1) * h;
     const BodyPose pose = motion.sample(t);
     targets = target_bones(*avatar, pose);

@@ -145,6 +145,53 @@ TEST(BoundedBiharmonic, NoFeasiblePerturbationLowersTheEnergy) {
   }
 }
 
+// The handle weights themselves, before the bone complement w_bone = 1 − Σ_k w_k
+// is formed (which makes "Σ W + w_bone = 1" true by construction): the QP
+// solutions are recomputed here with the low-level solver, and every stored row
+// must be that row divided by max(1, Σ_k w_k) — so a rescaled row sums to 1,
+// an unscaled one keeps its sum. Many handles on a small slab overlap, so many
+// rows need the rescale.
+TEST(BoundedBiharmonic, HandleRowsArePartitionOfUnityBeforeTheBoneComplement) {
+  const Slab s = slab();
+  const int K = 24;
+  const HandleSet hs = select_handles(s.mesh, s.role, K);
+  BbwOptions o = quiet();
+  o.drop_tolerance = 0.0;  // keep every entry: the comparison below is exact
+  BbwReport rep;
+  const MatX W = MatX(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, o, &rep));
+  // Independent QP solutions: 1 at handle k, 0 at the other handles and at Dirichlet nodes.
+  std::vector<int> fixed(hs.nodes.data(), hs.nodes.data() + K);
+  for (int i = 0; i < s.mesh.num_nodes(); ++i)
+    if (s.role(i) != 0) fixed.push_back(i);
+  const VecXi b = Eigen::Map<VecXi>(fixed.data(), Eigen::Index(fixed.size()));
+  MatX bc = MatX::Zero(b.size(), K);
+  for (int k = 0; k < K; ++k) bc(k, k) = 1.0;
+  const MatX Q = bounded_biharmonic_qp(s.mesh, b, bc, o);
+  int rescaled = 0;
+  double worst_rescaled_sum = 0, worst_row = 0;
+  for (int i = 0; i < s.mesh.num_nodes(); ++i) {
+    const double qsum = Q.row(i).sum();
+    const double expected_sum = std::min(qsum, 1.0);
+    if (qsum > 1.0 + 1e-9) {
+      ++rescaled;
+      worst_rescaled_sum = std::max(worst_rescaled_sum, std::abs(W.row(i).sum() - 1.0));
+    }
+    EXPECT_NEAR(W.row(i).sum(), expected_sum, 1e-9) << "node " << i << ", QP row sum " << qsum;
+    worst_row = std::max(worst_row, (W.row(i) - Q.row(i) / std::max(1.0, qsum)).lpNorm<Eigen::Infinity>());
+  }
+  std::printf("%d of %d rows had sum > 1 (max %.4f); rescaled rows sum to 1 within %.1e\n", rescaled,
+              s.mesh.num_nodes(), rep.max_sum_before_normalization, worst_rescaled_sum);
+  ASSERT_GE(rescaled, 5) << "the test needs overlapping handles";
+  EXPECT_EQ(rep.nodes_normalized, rescaled);
+  EXPECT_LT(worst_rescaled_sum, 1e-12);
+  EXPECT_LT(worst_row, 1e-9);
+  // With the default drop tolerance, a rescaled row loses at most K dropped entries.
+  const MatX Wdrop = MatX(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, quiet()));
+  for (int i = 0; i < s.mesh.num_nodes(); ++i)
+    if (Q.row(i).sum() > 1.0 + 1e-9)
+      EXPECT_GE(Wdrop.row(i).sum(), 1.0 - K * BbwOptions().drop_tolerance) << "node " << i;
+}
+
 TEST(BoundedBiharmonic, RejectsBadInput) {
   const Slab s = slab();
   VecXi handles(2);

@@ -27,6 +27,15 @@ class AtomicOutput {
   bool committed_ = false;
 };
 
+/// Checks, before any work starts, that a file can be written at `path`: it is
+/// not a folder, and its nearest existing ancestor is a folder in which a file
+/// can be created (tried with a temporary file that is removed at once).
+/// Creates nothing. Throws "OPTION PATH: ..." naming the reason.
+void check_output_file(const std::string& path, const std::string& option);
+/// The same for an output folder: `path` is an existing folder, or does not
+/// exist and can be created (nothing is created here).
+void check_output_folder(const std::string& path, const std::string& option);
+
 /// Lower-case extension of `path` including the dot (".obj"), "" if none.
 std::string lower_extension(const std::string& path);
 

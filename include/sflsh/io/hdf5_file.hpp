@@ -7,6 +7,7 @@
 //
 // Writing goes to "<path>.partial" and is renamed over <path> by commit(), so a
 // failed or interrupted job never leaves a half-written file behind.
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -17,11 +18,35 @@
 
 namespace sflsh::io {
 
+/// An HDF5 file image in memory, readable as Hdf5File(name, Mode::Read) (and so
+/// by every reader that takes a path) while this object lives: fuzzing and
+/// replaying inputs need no temporary files. `data` is not copied and must
+/// outlive this object; `name` must not be registered twice at once.
+class Hdf5MemoryImage {
+ public:
+  Hdf5MemoryImage(std::string name, const void* data, std::size_t size);
+  ~Hdf5MemoryImage();
+  Hdf5MemoryImage(const Hdf5MemoryImage&) = delete;
+  Hdf5MemoryImage& operator=(const Hdf5MemoryImage&) = delete;
+  const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+};
+
 class Hdf5File {
  public:
   enum class Mode { Read, Write };
-  /// Opens `path` for reading, or creates `<path>.partial` for writing.
+  /// Opens `path` for reading (a file, or a live Hdf5MemoryImage of that
+  /// name), or creates `<path>.partial` for writing.
+  ///
+  /// Reading guards memory: a dataset may declare at most
+  /// kMaxExpansion · (file size) + kMaxSmallDataset bytes of values (a
+  /// deflated dataset expands ~1000x at most), so a 1 kB file cannot make a
+  /// reader allocate gigabytes because a header says so.
   Hdf5File(const std::string& path, Mode mode);
+  static constexpr std::uint64_t kMaxExpansion = 4096;
+  static constexpr std::uint64_t kMaxSmallDataset = 16u << 20;  ///< bytes
   ~Hdf5File();  // Write mode without commit(): removes the partial file.
   Hdf5File(const Hdf5File&) = delete;
   Hdf5File& operator=(const Hdf5File&) = delete;
@@ -90,6 +115,9 @@ class Hdf5File {
 
  private:
   long open_dataset(const std::string& name) const;  // hid_t
+  // Throws unless `count` values of `bytes_each` bytes fit the guard above.
+  void check_declared_size(const std::string& name, std::uint64_t count, std::uint64_t bytes_each) const;
+  std::uint64_t file_bytes_ = 0;  // size of the file or image being read
   void ensure_parent_groups(const std::string& name);
   std::string path_, write_path_;
   Mode mode_;

@@ -34,6 +34,10 @@ std::string format_shape(const std::vector<std::int64_t>& shape);
 /// is given, where unicode/bytes arrays are collected instead.
 std::map<std::string, NpyArray> read_npz(const std::string& path,
                                          std::map<std::string, std::vector<std::string>>* strings = nullptr);
+/// read_npz over an archive held in memory (`bytes`); `name` stands for the
+/// file in messages.
+std::map<std::string, NpyArray> read_npz_bytes(const std::string& bytes, const std::string& name,
+                                               std::map<std::string, std::vector<std::string>>* strings = nullptr);
 /// What an .npz entry holds (read from its .npy header), for diagnostics:
 /// lists every entry, including object and string arrays that read_npz skips.
 struct NpzEntryInfo {
@@ -45,6 +49,8 @@ std::vector<NpzEntryInfo> list_npz(const std::string& path);
 
 /// One .npy file.
 NpyArray read_npy(const std::string& path);
+/// One .npy array held in memory; `name` stands for the file in messages.
+NpyArray read_npy_bytes(const std::string& bytes, const std::string& name);
 
 /// Writes an .npz (float64 arrays unless the array's dtype says "<f4", "<i4"
 /// or "<i8"), deflated when `compressed`. Atomic (temp file + rename).

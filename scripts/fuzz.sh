@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# Fuzz the readers with libFuzzer + AddressSanitizer + UBSan.
+#   scripts/fuzz.sh [SECONDS] [TARGET...]     (default: 60 s each, every target)
+# Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5.
+# Needs clang and compiler-rt (Debian: clang libclang-rt-14-dev; scripts/setup.sh).
+#
+# Builds into build-fuzz/ (the reader sources, instrumented; the rest from the
+# normal build's libraries, which it builds if needed), seeds each corpus with valid files
+# made from the project's own test data (test_fuzz with SFLSH_FUZZ_SEED_DIR,
+# from the normal build) plus tests/fuzz_regressions/<target>/, and runs each
+# target for SECONDS with a 10 s per-input timeout, a 2 GB RSS limit and a
+# 256 MB single-allocation limit (a small file must not make a reader
+# allocate more). A crash, leak, timeout or out-of-memory input is copied to
+# tests/fuzz_regressions/<target>/, which test_fuzz replays on every build:
+# fix the reader, then commit the input. Exit status: non-zero if any target
+# found something. FUZZ_BUILD_ONLY=1 only builds.
+set -euo pipefail
+SECONDS_TO_RUN="${1:-60}"
+[ $# -gt 0 ] && shift
+ALL_TARGETS=(bvh npz body_model_h5 avatar_h5 result_h5)
+TARGETS=("$@")
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL_TARGETS[@]}")
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+OUT="$ROOT/build-fuzz"
+CXX="${CXX_FUZZ:-clang++}"
+command -v ccache >/dev/null && CXX="ccache $CXX"
+mkdir -p "$OUT/obj"
+
+FLAGS=(-std=c++17 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+       -ffunction-sections -fdata-sections -I"$ROOT/include" -I"$ROOT/fuzz")
+read -r -a EIGEN <<< "$(pkg-config --cflags eigen3 2>/dev/null || echo -I/usr/include/eigen3)"
+read -r -a HDF5_CFLAGS <<< "$(pkg-config --cflags hdf5)"
+read -r -a LIBS <<< "$(pkg-config --libs hdf5 libzip) -lz"
+SOURCES=(fuzz/fuzz_targets.cpp src/core/*.cpp src/io/hdf5_file.cpp src/io/npz.cpp src/io/atomic_output.cpp
+         src/asset/avatar_file.cpp src/body/body_model_io.cpp src/body/body_model.cpp src/body/smpl_skeleton.cpp
+         src/motion/bvh.cpp src/motion/skeleton_motion.cpp src/motion/retarget.cpp src/motion/motion_clip.cpp
+         src/scene/simulation_run.cpp)
+
+echo "building the fuzz targets in $OUT ..."
+OBJS=()
+cd "$ROOT"
+for src in "${SOURCES[@]}"; do
+  obj="$OUT/obj/$(echo "$src" | tr / _).o"
+  # Rebuild when the source, or any project header, is newer than the object.
+  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find include fuzz -name '*.hpp' -newer "$obj" | head -1)" ]; then
+    $CXX "${FLAGS[@]}" -fsanitize=fuzzer-no-link "${EIGEN[@]}" "${HDF5_CFLAGS[@]}" -c "$src" -o "$obj"
+  fi
+  OBJS+=("$obj")
+done
+# The result reader shares its file with the simulation loop, which the fuzz
+# targets never call: its symbols come, uninstrumented, from the normal build's
+# libraries, linked after (and never instead of) the instrumented objects.
+BUILD="${SFLSH_BUILD_DIR:-build}"
+if [ ! -x "$BUILD/test_fuzz" ]; then
+  SFLSH_JOBS="${SFLSH_JOBS:-2}" bash scripts/build.sh --target test_fuzz > "$OUT/normal_build.log" 2>&1 ||
+    { tail -20 "$OUT/normal_build.log"; exit 1; }
+fi
+NORMAL_LIBS=()
+for m in scene sim motion asset basis volume body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
+for t in "${TARGETS[@]}"; do
+  $CXX "${FLAGS[@]}" -fsanitize=fuzzer -DSFLSH_FUZZ_TARGET="$t" "${EIGEN[@]}" fuzz/fuzz_main.cpp "${OBJS[@]}" \
+    -Wl,--gc-sections -Wl,--allow-multiple-definition "${NORMAL_LIBS[@]}" "${LIBS[@]}" \
+    -lcholmod -lsuitesparseconfig -ltbb -lpng -lassimp -lyaml-cpp -lgmp -lmpfr -o "$OUT/${t}_fuzz"
+done
+echo "making seed files from the project's test data ..."
+rm -rf "$OUT/seeds"
+SFLSH_FUZZ_SEED_DIR="$OUT/seeds" "${SFLSH_BUILD_DIR:-build}/test_fuzz" \
+  --gtest_filter=FuzzReplay.ValidAndMutatedProjectFiles > "$OUT/seeds.log" 2>&1 || { cat "$OUT/seeds.log"; exit 1; }
+
+run_target() {
+  local t="$1" log="$OUT/$1.log"
+  mkdir -p "$OUT/corpus/$t" "$OUT/crashes/$t" "$OUT/seeds/$t" "$ROOT/tests/fuzz_regressions/$t"
+  local max_len=65536
+  for f in "$OUT/seeds/$t"/*; do
+    [ -f "$f" ] && [ "$(stat -c %s "$f")" -gt "$max_len" ] && max_len=$(stat -c %s "$f")
+  done
+  local status=0
+  (cd "$OUT" && ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" \
+     -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
+     -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$ROOT/tests/fuzz_regressions/$t" \
+     > "$log" 2>&1) || status=$?
+  local execs cov
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*')
+  local found=0
+  for a in "$OUT/crashes/$t"/*; do
+    [ -f "$a" ] || continue
+    cp "$a" "$ROOT/tests/fuzz_regressions/$t/"
+    found=$((found + 1))
+  done
+  echo "$t: ${execs:-?} executions, coverage ${cov:-?} edges, corpus $(ls "$OUT/corpus/$t" | wc -l) inputs, exit $status, $found finding(s) (log: $log)"
+  [ "$status" -eq 0 ] && [ "$found" -eq 0 ]
+}
+
+echo "fuzzing ${TARGETS[*]} for $SECONDS_TO_RUN s each ..."
+failed=0
+for t in "${TARGETS[@]}"; do
+  run_target "$t" || failed=1
+done
+if [ "$failed" -ne 0 ]; then
+  echo "findings were copied to tests/fuzz_regressions/<target>/: fix the reader, replay with build/test_fuzz, commit them"
+  exit 1
+fi
+echo "no findings"

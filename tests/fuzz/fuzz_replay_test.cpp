@@ -1,0 +1,177 @@
+// Replays every fuzz target (fuzz/fuzz_targets.hpp) over
+//  - the regression inputs under tests/fuzz_regressions/<target>/ (inputs that
+//    once crashed a reader: each must now parse or throw sflsh::Error), and
+//  - valid files made here (and the project's own test files), each also cut
+//    short at several lengths and with bytes overwritten at spread positions:
+//    a small, deterministic mutation pass that runs on every build.
+// With SFLSH_FUZZ_SEED_DIR set, the valid files are also written to
+// $SFLSH_FUZZ_SEED_DIR/<target>/ (scripts/fuzz.sh seeds its corpora so).
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "fuzz_targets.hpp"
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/io/npz.hpp"
+#include "sflsh/scene/simulation_run.hpp"
+#include "sim/synthetic_avatar.hpp"
+#include "test_support.hpp"
+
+using namespace sflsh;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const fuzz::Target& target(const std::string& name) {
+  for (const auto& t : fuzz::all_targets())
+    if (t.name == name) return t;
+  throw std::runtime_error("no fuzz target " + name);
+}
+
+void run(const fuzz::Target& t, const std::string& bytes) {
+  t.run(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+}
+
+// The valid input, 12 truncations and 64 single-byte overwrites (positions
+// spread over the file, values cycling through 0x00, 0xff, 0x7f, 0x80, ...).
+void run_with_mutations(const fuzz::Target& t, const std::string& bytes) {
+  run(t, bytes);
+  for (int k = 0; k < 12; ++k) run(t, bytes.substr(0, bytes.size() * k / 12));
+  const unsigned char values[] = {0x00, 0xff, 0x7f, 0x80, 0x01, 0x40};
+  for (int k = 0; k < 64 && !bytes.empty(); ++k) {
+    std::string m = bytes;
+    m[(bytes.size() * size_t(k)) / 64 + size_t(k) % 7 < bytes.size() ? (bytes.size() * size_t(k)) / 64 + size_t(k) % 7
+                                                                       : bytes.size() - 1] = char(values[k % 6]);
+    run(t, m);
+  }
+}
+
+// Writes `bytes` as a seed for scripts/fuzz.sh when SFLSH_FUZZ_SEED_DIR is set.
+void offer_seed(const std::string& target_name, const std::string& file_name, const std::string& bytes) {
+  const char* dir = std::getenv("SFLSH_FUZZ_SEED_DIR");
+  if (!dir || !*dir) return;
+  const fs::path d = fs::path(dir) / target_name;
+  fs::create_directories(d);
+  std::ofstream(d / file_name, std::ios::binary) << bytes;
+}
+
+void check_valid_file(const std::string& target_name, const std::string& file_name, const std::string& bytes) {
+  SCOPED_TRACE(target_name + " " + file_name);
+  offer_seed(target_name, file_name, bytes);
+  run_with_mutations(target(target_name), bytes);
+}
+
+SimulationResult tiny_result() {
+  SimulationResult r;
+  r.avatar = "a.h5";
+  r.motion = "builtin:jump";
+  r.dt = 1.0 / 60;
+  r.faces.resize(1, 3);
+  r.faces << 0, 1, 2;
+  r.surface_rest = Points::Random(3, 3);
+  for (int f = 0; f < 3; ++f) {
+    r.frame_time.push_back(f / 30.0);
+    r.frame_step_ms.push_back(1.0);
+    r.frame_positions.push_back(Points::Constant(3, 3, 0.1 * f));
+    r.frame_displacement.push_back(Points::Constant(3, 3, 0.001 * f));
+    r.frame_joints.push_back(Points::Constant(24, 3, 0.2 * f));
+    r.frame_reduced.push_back(VecX::Constant(6, 0.01 * f));
+    r.frame_target_pelvis.push_back(Vec3(0, 0.9, 0.1 * f));
+  }
+  r.num_frames = 3;
+  for (int s = 0; s < 4; ++s) {
+    r.step_time.push_back((s + 1) / 60.0);
+    r.step_energy.push_back(s);
+    r.step_grad_norm.push_back(0.5 * s);
+    r.step_decrement.push_back(0.1 * s);
+    r.step_outcome.push_back(s % 3);
+    r.step_ms.push_back(1.5);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(FuzzReplay, RegressionInputsParseOrThrowTheProjectError) {
+  const fs::path root = fs::path(test::source_dir()) / "tests" / "fuzz_regressions";
+  int replayed = 0;
+  for (const auto& t : fuzz::all_targets()) {
+    const fs::path dir = root / t.name;
+    if (!fs::is_directory(dir)) continue;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (!e.is_regular_file() || e.path().filename() == "README.md") continue;
+      SCOPED_TRACE(e.path().string());
+      run(t, read_bytes(e.path()));
+      ++replayed;
+    }
+  }
+  std::printf("replayed %d regression inputs\n", replayed);
+}
+
+TEST(FuzzReplay, ValidAndMutatedProjectFiles) {
+  test::TempDir tmp;
+  // BVH: the committed test motions.
+  for (const auto& e : fs::directory_iterator(fs::path(test::source_dir()) / "tests" / "data" / "motion"))
+    if (e.path().extension() == ".bvh") check_valid_file("bvh", e.path().filename().string(), read_bytes(e.path()));
+  // npz: the generated tiny SMPL model (deflated arrays) and an uncompressed archive with an int array.
+  const std::string tiny_npz = test::generated_fixture("tiny_smpl.npz");
+  check_valid_file("npz", "tiny_smpl.npz", read_bytes(tiny_npz));
+  io::NpyArray a;
+  a.shape = {2, 3};
+  a.dtype = "<i4";
+  a.data = {1, 2, 3, 4, 5, 6};
+  io::write_npz(tmp.file("small.npz"), {{"a", a}}, false);
+  check_valid_file("npz", "small.npz", read_bytes(tmp.file("small.npz")));
+  // Body model, avatar and result HDF5 files.
+  write_body_model_hdf5(read_body_model_npz(tiny_npz), tmp.file("body.h5"));
+  check_valid_file("body_model_h5", "tiny_body.h5", read_bytes(tmp.file("body.h5")));
+  test::SyntheticAvatarOptions o;
+  o.nx = 1, o.ny = 2, o.nz = 1, o.handles = 3;
+  write_avatar(test::make_synthetic_avatar(o), tmp.file("avatar.h5"));
+  check_valid_file("avatar_h5", "synthetic_avatar.h5", read_bytes(tmp.file("avatar.h5")));
+  write_simulation_result(tiny_result(), tmp.file("result.h5"));
+  check_valid_file("result_h5", "tiny_result.h5", read_bytes(tmp.file("result.h5")));
+}
+
+TEST(FuzzReplay, AHugeDeclaredDatasetInATinyFileIsRejectedBeforeAllocating) {
+  // A file of a few kB whose chunked dataset declares 2^36 x 3 doubles (1.6 TB)
+  // that were never written (HDF5 then stores no chunks, only the extent).
+  test::TempDir tmp;
+  const std::string path = tmp.file("huge.h5");
+  {
+    const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hsize_t dims[2] = {hsize_t(1) << 36, 3}, chunk[2] = {1024, 3};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 2, chunk);
+    const hid_t ds = H5Dcreate2(file, "/nodes", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    H5Dclose(ds);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+    H5Fclose(file);
+  }
+  ASSERT_LT(fs::file_size(path), 100000u);
+  const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
+  EXPECT_EQ(f.shape("/nodes"), (std::vector<std::int64_t>{std::int64_t(1) << 36, 3}));
+  test::expect_error([&] { f.read_matrix("/nodes", -1, 3); }, {"huge.h5", "/nodes", "declares"});
+  // The same bytes as an in-memory image.
+  const std::string bytes = read_bytes(path);
+  const io::Hdf5MemoryImage image("huge-in-memory.h5", bytes.data(), bytes.size());
+  const io::Hdf5File g(image.name(), io::Hdf5File::Mode::Read);
+  test::expect_error([&] { g.read_matrix("/nodes", -1, 3); }, {"huge-in-memory.h5", "/nodes", "declares"});
+}
