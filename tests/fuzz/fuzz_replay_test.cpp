@@ -19,7 +19,8 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/io/npz.hpp"
-#include "sflsh/scene/simulation_run.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sim/synthetic_avatar.hpp"
 #include "test_support.hpp"
 
