@@ -34,7 +34,7 @@ read -r -a LIBS <<< "$(pkg-config --libs hdf5 libzip) -lz"
 SOURCES=(fuzz/fuzz_targets.cpp src/core/*.cpp src/io/hdf5_file.cpp src/io/npz.cpp src/io/atomic_output.cpp
          src/asset/avatar_file.cpp src/body/body_model_io.cpp src/body/body_model.cpp src/body/smpl_skeleton.cpp
          src/motion/bvh.cpp src/motion/skeleton_motion.cpp src/motion/retarget.cpp src/motion/motion_clip.cpp
-         src/scene/simulation_run.cpp)
+         src/scene/result_file.cpp)
 
 echo "building the fuzz targets in $OUT ..."
 OBJS=()
@@ -47,8 +47,8 @@ for src in "${SOURCES[@]}"; do
   fi
   OBJS+=("$obj")
 done
-# The result reader shares its file with the simulation loop, which the fuzz
-# targets never call: its symbols come, uninstrumented, from the normal build's
+# Whatever else the instrumented objects reference (the fuzz targets never
+# simulate) comes, uninstrumented, from the normal build's
 # libraries, linked after (and never instead of) the instrumented objects.
 BUILD="${SFLSH_BUILD_DIR:-build}"
 if [ ! -x "$BUILD/test_fuzz" ]; then
@@ -56,7 +56,7 @@ if [ ! -x "$BUILD/test_fuzz" ]; then
     { tail -20 "$OUT/normal_build.log"; exit 1; }
 fi
 NORMAL_LIBS=()
-for m in scene sim motion asset basis volume body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
+for m in scene sim motion asset fem geometry body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
 for t in "${TARGETS[@]}"; do
   $CXX "${FLAGS[@]}" -fsanitize=fuzzer -DSFLSH_FUZZ_TARGET="$t" "${EIGEN[@]}" fuzz/fuzz_main.cpp "${OBJS[@]}" \
     -Wl,--gc-sections -Wl,--allow-multiple-definition "${NORMAL_LIBS[@]}" "${LIBS[@]}" \
