@@ -1,13 +1,17 @@
 #include "sflsh/sim/energy_term.hpp"
 
+#include <optional>
+
 namespace sflsh {
 
 double EnergyTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
   if (!grad && !hess) return compute(ctx, q, nullptr, nullptr);
   // Views of the whole caller-sized vectors: the term's local system.
-  std::unique_ptr<VecRef> g = grad ? std::make_unique<VecRef>(*grad) : nullptr;
-  std::unique_ptr<MatRef> H = hess ? std::make_unique<MatRef>(*hess) : nullptr;
-  return compute(ctx, q, g.get(), H.get());
+  std::optional<VecRef> g;
+  std::optional<MatRef> H;
+  if (grad) g.emplace(*grad);
+  if (hess) H.emplace(*hess);
+  return compute(ctx, q, g ? &*g : nullptr, H ? &*H : nullptr);
 }
 
 std::unique_ptr<TermCache> begin_term_step(const EnergyTerm& term, StepContext& ctx) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <Eigen/Cholesky>
 
@@ -51,18 +52,20 @@ double evaluate_term(SystemTerm& t, const std::vector<Configuration>& q, VecX* g
   const Configuration& q0 = ctx.bound.empty() ? q[0] : q[ctx.bound[0].slot];
   const TermPlacement& p = t.placement;
   if (p.local_size == 0 || (!grad && !hess)) return t.term->compute(ctx, q0, nullptr, nullptr);
+  // Views on the stack: no allocation per term and evaluation.
+  std::optional<VecRef> g;
+  std::optional<MatRef> H;
   if (p.contiguous) {
-    std::unique_ptr<VecRef> g = grad ? std::make_unique<VecRef>(grad->segment(p.offset, p.local_size)) : nullptr;
-    std::unique_ptr<MatRef> H =
-        hess ? std::make_unique<MatRef>(hess->block(p.offset, p.offset, p.local_size, p.local_size)) : nullptr;
-    return t.term->compute(ctx, q0, g.get(), H.get());
+    if (grad) g.emplace(grad->segment(p.offset, p.local_size));
+    if (hess) H.emplace(hess->block(p.offset, p.offset, p.local_size, p.local_size));
+    return t.term->compute(ctx, q0, g ? &*g : nullptr, H ? &*H : nullptr);
   }
   // Scattered: fill a local system, then add each (piece, piece) block.
   if (grad) g_local.setZero(p.local_size);
   if (hess) H_local.setZero(p.local_size, p.local_size);
-  std::unique_ptr<VecRef> g = grad ? std::make_unique<VecRef>(g_local) : nullptr;
-  std::unique_ptr<MatRef> H = hess ? std::make_unique<MatRef>(H_local) : nullptr;
-  const double e = t.term->compute(ctx, q0, g.get(), H.get());
+  if (grad) g.emplace(g_local);
+  if (hess) H.emplace(H_local);
+  const double e = t.term->compute(ctx, q0, g ? &*g : nullptr, H ? &*H : nullptr);
   int li = 0;
   for (const auto& [gi, ni] : p.ranges) {
     if (grad) grad->segment(gi, ni) += g_local.segment(li, ni);
