@@ -7,12 +7,13 @@
 # Builds into build-fuzz/ (the reader sources, instrumented; the rest from the
 # normal build's libraries, which it builds if needed), seeds each corpus with valid files
 # made from the project's own test data (test_fuzz with SFLSH_FUZZ_SEED_DIR,
-# from the normal build) plus tests/fuzz_regressions/<target>/, and runs each
+# from the normal build) plus earlier findings in build-fuzz/crashes/<target>/, and runs each
 # target for SECONDS with a 10 s per-input timeout, a 2 GB RSS limit and a
 # 256 MB single-allocation limit (a small file must not make a reader
-# allocate more). A crash, leak, timeout or out-of-memory input is copied to
-# tests/fuzz_regressions/<target>/, which test_fuzz replays on every build:
-# fix the reader, then commit the input. Exit status: non-zero if any target
+# allocate more). A crash, leak, timeout or out-of-memory input stays in
+# build-fuzz/crashes/<target>/ (generated data is not committed); replay them with
+# SFLSH_FUZZ_REPLAY_DIR=build-fuzz/crashes build/test_fuzz, fix the reader, and
+# turn the case into a test that builds its input. Exit status: non-zero if any target
 # found something. FUZZ_BUILD_ONLY=1 only builds.
 set -euo pipefail
 SECONDS_TO_RUN="${1:-60}"
@@ -69,7 +70,7 @@ SFLSH_FUZZ_SEED_DIR="$OUT/seeds" "${SFLSH_BUILD_DIR:-build}/test_fuzz" \
 
 run_target() {
   local t="$1" log="$OUT/$1.log"
-  mkdir -p "$OUT/corpus/$t" "$OUT/crashes/$t" "$OUT/seeds/$t" "$ROOT/tests/fuzz_regressions/$t"
+  mkdir -p "$OUT/corpus/$t" "$OUT/crashes/$t" "$OUT/seeds/$t"
   local max_len=65536
   for f in "$OUT/seeds/$t"/*; do
     [ -f "$f" ] && [ "$(stat -c %s "$f")" -gt "$max_len" ] && max_len=$(stat -c %s "$f")
@@ -77,7 +78,7 @@ run_target() {
   local status=0
   (cd "$OUT" && ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" \
      -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
-     -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$ROOT/tests/fuzz_regressions/$t" \
+     -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$OUT/crashes/$t" \
      > "$log" 2>&1) || status=$?
   local execs cov
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
@@ -85,7 +86,6 @@ run_target() {
   local found=0
   for a in "$OUT/crashes/$t"/*; do
     [ -f "$a" ] || continue
-    cp "$a" "$ROOT/tests/fuzz_regressions/$t/"
     found=$((found + 1))
   done
   echo "$t: ${execs:-?} executions, coverage ${cov:-?} edges, corpus $(ls "$OUT/corpus/$t" | wc -l) inputs, exit $status, $found finding(s) (log: $log)"
@@ -98,7 +98,7 @@ for t in "${TARGETS[@]}"; do
   run_target "$t" || failed=1
 done
 if [ "$failed" -ne 0 ]; then
-  echo "findings were copied to tests/fuzz_regressions/<target>/: fix the reader, replay with build/test_fuzz, commit them"
+  echo "findings are in $OUT/crashes/<target>/: replay with SFLSH_FUZZ_REPLAY_DIR=$OUT/crashes build/test_fuzz"
   exit 1
 fi
 echo "no findings"
