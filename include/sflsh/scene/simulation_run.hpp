@@ -37,16 +37,36 @@ struct RunOptions {
   std::string checkpoint;
 };
 
+/// A rigid object of a scene as results show it (issue 10): its surface in
+/// its own frame and its pose per output frame.
+struct ObjectTrack {
+  std::string name;
+  std::string shape;            ///< "plane", "sphere", "box", "capsule", "cylinder", "mesh"
+  std::string kind;             ///< "static", "kinematic", "dynamic"
+  Points vertices;              ///< surface in the object's frame (m); a plane is a finite patch
+  Triangles faces;
+  std::vector<Isometry> poses;  ///< one per output frame: object frame → world
+};
+
 /// One output frame (what the result file stores per frame).
 struct FrameData {
   double time = 0, step_ms = 0;
-  Points positions, displacement, joints;
-  VecX reduced;
-  Vec3 target_pelvis = Vec3::Zero();  ///< the motion's pelvis at `time` (world, m)
+  /// Skin of every body, concatenated in body order (SimulationResult::body_vertex_offsets).
+  Points positions, displacement;
+  Points joints;  ///< 24 rows per body, in body order
+  VecX reduced;   ///< every body's z, concatenated
+  Vec3 target_pelvis = Vec3::Zero();  ///< the motion's pelvis at `time` (world, m; first body)
+  std::vector<Isometry> object_poses;  ///< one per SimulationResult::objects entry
 };
 
 struct SimulationResult {
   std::string avatar, motion;
+  /// Scenes with several bodies: their names, and where each one's skin
+  /// vertices start in faces/positions (#bodies + 1 entries). Empty = one body.
+  std::vector<std::string> body_names;
+  std::vector<int> body_vertex_offsets;
+  /// Rigid objects of the scene (poses per output frame); empty without objects.
+  std::vector<ObjectTrack> objects;
   double dt = 0;
   bool bones_dynamic = false;
   int newton_iters = 1;
