@@ -23,7 +23,8 @@ std::string Model::describe() const {
   std::ostringstream o;
   o << num_dofs_ << " DoFs in " << blocks_.size() << " blocks\n";
   for (const Body& b : bodies_)
-    o << "  body " << b.name << ": bones " << (b.bones_dynamic ? "dynamic" : "kinematic") << ", DoFs ["
+    o << "  body " << b.name << ": " << (b.rigid() ? "rigid object" : b.bones_dynamic ? "bones dynamic" : "bones kinematic")
+      << ", DoFs ["
       << b.layout.base << ", " << b.layout.end() << ")\n";
   for (size_t g = 0; g < groups_.size(); ++g) {
     o << "  group " << g << ": DoFs [" << groups_[g].offset << ", " << groups_[g].offset + groups_[g].size
@@ -43,7 +44,7 @@ std::string Model::describe() const {
 }
 
 int ModelBuilder::add_body(BodySpec spec) {
-  require(spec.avatar != nullptr, "ModelBuilder::add_body: body '", spec.name, "' has no avatar");
+  if (!spec.avatar) spec.bones_dynamic = true;  // a rigid object (model.hpp)
   for (const BodySpec& s : specs_)
     require(s.name != spec.name, "ModelBuilder::add_body: two bodies are called '", spec.name, "'");
   specs_.push_back(std::move(spec));
@@ -53,6 +54,7 @@ int ModelBuilder::add_body(BodySpec spec) {
 const Avatar& ModelBuilder::avatar(int body) const {
   require(body >= 0 && body < int(specs_.size()), "ModelBuilder: body ", body, " does not exist (", specs_.size(),
           " bodies)");
+  require(specs_[body].avatar != nullptr, "ModelBuilder: body '", specs_[body].name, "' is a rigid object, not an avatar");
   return *specs_[body].avatar;
 }
 
@@ -106,13 +108,18 @@ std::shared_ptr<const Model> ModelBuilder::build() const {
       body.avatar = s.avatar;
       body.bones_dynamic = s.bones_dynamic;
       DofLayout& l = body.layout;
-      l.num_bones = 24;
+      l.num_bones = s.avatar ? 24 : 1;
       l.bones_dynamic = s.bones_dynamic;
-      l.num_reduced = s.avatar->num_reduced();
+      l.num_reduced = s.avatar ? s.avatar->num_reduced() : 0;
       l.base = offset;
       // Each bone turns about its own joint: the Newton step's linearization then
-      // keeps the stiff joint constraints closed on fast distal motion.
-      if (s.avatar->joints_rest.rows() == 24) l.bone_pivots = s.avatar->joints_rest;
+      // keeps the stiff joint constraints closed on fast distal motion. A rigid
+      // object turns about its centre of mass, its frame's origin.
+      if (!s.avatar) {
+        l.bone_pivots = Points::Zero(1, 3);
+      } else if (s.avatar->joints_rest.rows() == 24) {
+        l.bone_pivots = s.avatar->joints_rest;
+      }
       if (l.bones_dynamic)
         for (int i = 0; i < l.num_bones; ++i) m->blocks_.push_back({DofBlock::Kind::Bone, b, i, l.bone_offset(i), 6});
       if (l.num_reduced > 0) m->blocks_.push_back({DofBlock::Kind::Soft, b, -1, l.z_offset(), l.num_reduced});

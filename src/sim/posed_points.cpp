@@ -97,6 +97,45 @@ PosedPoints PosedPoints::at_surface(const Avatar& a) {
   return P;
 }
 
+PosedPoints PosedPoints::subset(const std::vector<int>& rows) const {
+  PosedPoints P;
+  P.x_unposed_.resize(int(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const int p = rows[i];
+    require(p >= 0 && p < size(), "PosedPoints::subset: row ", p, " out of [0, ", size(), ")");
+    P.x_unposed_.row(int(i)) = x_unposed_.row(p);
+    for (int e = bone_start_[p]; e < bone_start_[p + 1]; ++e) {
+      P.bone_index_.push_back(bone_index_[e]);
+      P.bone_weight_.push_back(bone_weight_[e]);
+    }
+    P.bone_start_.push_back(int(P.bone_index_.size()));
+    for (int e = handle_start_[p]; e < handle_start_[p + 1]; ++e) {
+      P.handle_index_.push_back(handle_index_[e]);
+      P.handle_weight_.push_back(handle_weight_[e]);
+    }
+    P.handle_start_.push_back(int(P.handle_index_.size()));
+  }
+  return P;
+}
+
+Vec3 PosedPoints::world_point(int p, const Configuration& q) const {
+  const Vec3 y = local(p, q.z);
+  Vec3 x = Vec3::Zero();
+  for (int e = bone_start_[p]; e < bone_start_[p + 1]; ++e) x += bone_weight_[e] * (q.bones[bone_index_[e]] * y);
+  return x;
+}
+
+int PosedPoints::dominant_bone(int p) const {
+  int best = -1;
+  double w = 0;
+  for (int e = bone_start_[p]; e < bone_start_[p + 1]; ++e)
+    if (bone_weight_[e] > w) {
+      w = bone_weight_[e];
+      best = bone_index_[e];
+    }
+  return best;
+}
+
 Vec3 PosedPoints::local(int p, const VecX& z) const {
   Vec3 y = x_unposed_.row(p).transpose();
   for (int e = handle_start_[p]; e < handle_start_[p + 1]; ++e)
@@ -113,8 +152,11 @@ Points PosedPoints::soft_displacement(const VecX& z) const {
 Points PosedPoints::world(const Configuration& q, const Points* offsets) const {
   Points x(size(), 3);
   for (int p = 0; p < size(); ++p) {
-    Vec3 y = local(p, q.z);
-    if (offsets) y += offsets->row(p).transpose();
+    if (!offsets) {
+      x.row(p) = world_point(p, q).transpose();
+      continue;
+    }
+    const Vec3 y = local(p, q.z) + offsets->row(p).transpose();
     Vec3 xp = Vec3::Zero();
     for (int e = bone_start_[p]; e < bone_start_[p + 1]; ++e) xp += bone_weight_[e] * (q.bones[bone_index_[e]] * y);
     x.row(p) = xp.transpose();

@@ -8,7 +8,8 @@ std::vector<Isometry> identity_bones() { return std::vector<Isometry>(24, Isomet
 
 Simulator::Simulator(std::shared_ptr<const Model> model) : model_(std::move(model)) {
   require(model_ != nullptr, "Simulator: null model");
-  for (const Model::Body& b : model_->bodies()) surfaces_.push_back(PosedPoints::at_surface(*b.avatar));
+  for (const Model::Body& b : model_->bodies())
+    surfaces_.push_back(b.rigid() ? PosedPoints() : PosedPoints::at_surface(*b.avatar));
   state_ = rest_state(*model_);
 }
 
@@ -43,13 +44,21 @@ void Simulator::set_state(const State& state) {
   state_ = state;
 }
 
+const Avatar& Simulator::avatar(int body) const {
+  const Model::Body& b = model_->bodies().at(body);
+  require(!b.rigid(), "body '", b.name, "' is a rigid object, not an avatar");
+  return *b.avatar;
+}
+
 Points Simulator::posed_surface(int body) const {
   const Configuration& q = state(body);
   const Points b = surface_pose_offsets(avatar(body), q.bones);
   return surfaces_.at(body).world(q, &b);
 }
 
-Points Simulator::soft_displacement(int body) const { return surfaces_.at(body).soft_displacement(state(body).z); }
+Points Simulator::soft_displacement(int body) const {
+  avatar(body);  // throws for a rigid object
+  return surfaces_.at(body).soft_displacement(state(body).z); }
 
 Points Simulator::joints(int body) const { return posed_joints(avatar(body), state(body).bones); }
 

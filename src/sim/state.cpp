@@ -28,8 +28,8 @@ State rest_state(const Model& model) {
   State s;
   for (const Model::Body& b : model.bodies()) {
     Configuration q;
-    q.bones.assign(24, Isometry::Identity());
-    q.z = VecX::Zero(b.avatar->num_reduced());
+    q.bones.assign(b.num_bones(), Isometry::Identity());
+    q.z = VecX::Zero(b.layout.num_reduced);
     s.bodies.push_back({q, q});
   }
   return s;
@@ -42,9 +42,10 @@ void validate_state(const Model& model, const State& s) {
   for (size_t b = 0; b < s.bodies.size(); ++b) {
     const std::string& name = model.bodies()[b].name;
     for (const Configuration* c : {&s.bodies[b].q, &s.bodies[b].q_prev}) {
-      require(c->bones.size() == 24, "state of body '", name, "': ", c->bones.size(), " bones, expected 24");
-      require(c->z.size() == model.bodies()[b].avatar->num_reduced(), "state of body '", name, "': z has ",
-              c->z.size(), " entries, expected 3K = ", model.bodies()[b].avatar->num_reduced());
+      const int bones = model.bodies()[b].num_bones(), K3 = model.bodies()[b].layout.num_reduced;
+      require(int(c->bones.size()) == bones, "state of body '", name, "': ", c->bones.size(), " bones, expected ",
+              bones);
+      require(c->z.size() == K3, "state of body '", name, "': z has ", c->z.size(), " entries, expected 3K = ", K3);
       require(c->z.allFinite(), "state of body '", name, "': z is not finite");
       for (const Isometry& G : c->bones)
         require(G.matrix().allFinite(), "state of body '", name, "': a bone transform is not finite");

@@ -68,10 +68,10 @@ State read_state(const std::string& path, const Model& model) {
     require(names[b] == body.name, path, ": /state/bodies[", b, "] is '", names[b], "', the scene's body ", b,
             " is '", body.name, "'");
     const std::string g = "/state/" + std::to_string(b) + "/";
-    const std::int64_t r = body.avatar->num_reduced();
+    const std::int64_t r = body.layout.num_reduced;
     BodyState st;
-    st.q.bones = unpack_bones(f.read_matrix(g + "bones", 24, 12));
-    st.q_prev.bones = unpack_bones(f.read_matrix(g + "bones_prev", 24, 12));
+    st.q.bones = unpack_bones(f.read_matrix(g + "bones", body.num_bones(), 12));
+    st.q_prev.bones = unpack_bones(f.read_matrix(g + "bones_prev", body.num_bones(), 12));
     const std::vector<double> z = f.read_nd(g + "z", {r}), zp = f.read_nd(g + "z_prev", {r});
     st.q.z = Eigen::Map<const VecX>(z.data(), r);
     st.q_prev.z = Eigen::Map<const VecX>(zp.data(), r);

@@ -20,15 +20,24 @@ void translate_bones(std::vector<Isometry>& bones, const Vec3& d) {
 void validate_inputs(const Model& m, const StepInputs& in) {
   require(in.bodies.size() == m.bodies().size(), "step: inputs for ", in.bodies.size(), " bodies, the model has ",
           m.bodies().size());
-  for (size_t b = 0; b < in.bodies.size(); ++b)
-    require(in.bodies[b].bones.size() == 24, "step: body '", m.bodies()[b].name, "' has ", in.bodies[b].bones.size(),
-            " target bones, expected 24");
+  for (size_t b = 0; b < in.bodies.size(); ++b) {
+    const Model::Body& body = m.bodies()[b];
+    if (body.rigid()) {
+      require(in.bodies[b].bones.empty(), "step: body '", body.name,
+              "' is a dynamic rigid object; it takes no target bones, got ", in.bodies[b].bones.size());
+    } else {
+      require(in.bodies[b].bones.size() == 24, "step: body '", body.name, "' has ", in.bodies[b].bones.size(),
+              " target bones, expected 24");
+    }
+  }
 }
 
-/// World point a body's step frame is centred on: its pelvis at time t.
-Vec3 pelvis_origin(const Avatar& a, const Configuration& q) {
+/// World point a body's step frame is centred on: its pelvis at time t (a
+/// rigid object's centre of mass).
+Vec3 pelvis_origin(const Model::Body& b, const Configuration& q) {
   const Isometry& G = q.bones[0];
-  return a.joints_rest.rows() > 0 ? Vec3(G * Vec3(a.joints_rest.row(0).transpose())) : Vec3(G.translation());
+  return b.avatar && b.avatar->joints_rest.rows() > 0 ? Vec3(G * Vec3(b.avatar->joints_rest.row(0).transpose()))
+                                                       : Vec3(G.translation());
 }
 
 /// One group's step (step.hpp): its own frame, its own Newton system.
@@ -39,7 +48,7 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
   // Inertia predictions shift with q_t, q_{t−1} (x* = 2x_t − x_{t−1} moves by
   // the same −c), targets and frames shift with the bones, and gravity's
   // energy changes by the constant M g·c, which has no gradient.
-  const Vec3 c = pelvis_origin(*m.bodies()[g.bodies[0]].avatar, s.bodies[g.bodies[0]].q);
+  const Vec3 c = pelvis_origin(m.bodies()[g.bodies[0]], s.bodies[g.bodies[0]].q);
   ws.targets.resize(g.bodies.size());
   for (size_t k = 0; k < g.bodies.size(); ++k) {
     ws.targets[k] = inputs.bodies[g.bodies[k]];
@@ -142,7 +151,7 @@ void merge_report(StepReport& total, StepReport& g, const std::vector<int>& term
 
 Vec3 step_frame_origin(const Model& m, const State& s) {
   if (m.bodies().empty()) return Vec3::Zero();
-  return pelvis_origin(*m.bodies()[0].avatar, s.bodies[0].q);
+  return pelvis_origin(m.bodies()[0], s.bodies[0].q);
 }
 
 StepReport step(const Model& m, State& s, const StepInputs& inputs) {

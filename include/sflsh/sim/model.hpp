@@ -7,6 +7,7 @@
 //
 // Block DoF layout of the step vector δ (sizes in DoFs):
 //   [ body 0: bone 0 (6) … bone 23 (6) | soft (3K) ][ body 1: … ] …
+// (a dynamic rigid object is a body with one 6-DoF block).
 // A body with kinematic (prescribed) bones contributes no bone blocks; a body
 // without handles no soft block. Each body's blocks are contiguous, so a term
 // on one body writes straight into the global system; a term coupling bodies
@@ -40,11 +41,17 @@ struct DofBlock {
   int size = 0;    ///< 6 (bone) or 3K (soft)
 };
 
-/// A body as the scene declares it.
+/// A body as the scene declares it: an avatar, or (avatar null) a dynamic
+/// rigid object — one "bone" G mapping the object's frame, centred on its
+/// centre of mass, to the world; 6 DoFs turning about the centre of mass, no
+/// soft block. Its mass enters through the terms the scene adds
+/// (rigid_body_terms.hpp); kinematic and static objects are not bodies but
+/// named world frames (StepInputs::frames).
 struct BodySpec {
-  std::string name;                        ///< unique within the model (e.g. "avatar", "alice")
-  std::shared_ptr<const Avatar> avatar;    ///< its asset (shared, immutable)
-  bool bones_dynamic = false;              ///< bones are DoFs (true) or prescribed by the targets (false)
+  std::string name;                        ///< unique within the model (e.g. "avatar", "alice", "ball")
+  std::shared_ptr<const Avatar> avatar;    ///< its asset (shared, immutable); null: a rigid object
+  bool bones_dynamic = false;              ///< bones are DoFs (true) or prescribed by the targets (false);
+                                           ///< a rigid object is always dynamic
 };
 
 /// Solver settings of a model.
@@ -60,9 +67,12 @@ class Model {
  public:
   struct Body {
     std::string name;
-    std::shared_ptr<const Avatar> avatar;
+    std::shared_ptr<const Avatar> avatar;  ///< null for a rigid object
     bool bones_dynamic = false;
     DofLayout layout;  ///< its blocks in the global step vector (base = its first DoF)
+    bool rigid() const { return avatar == nullptr; }
+    /// Bones of its configuration: 24 for an avatar, 1 for a rigid object.
+    int num_bones() const { return layout.num_bones; }
   };
   /// A term and where its local system sits in the global one.
   struct BoundTerm {
@@ -120,7 +130,8 @@ class ModelBuilder {
   ModelBuilder() = default;
   explicit ModelBuilder(ModelOptions options) : options_(std::move(options)) {}
   /// Adds a body; returns its index. Its bones turn about its own joints
-  /// (DofLayout::bone_pivots = avatar.joints_rest when it has 24 joints).
+  /// (DofLayout::bone_pivots = avatar.joints_rest when it has 24 joints); a
+  /// rigid object turns about its centre of mass (its frame's origin).
   int add_body(BodySpec spec);
   /// Binds `term` to `bodies` (indices from add_body; the first is the one its
   /// single-body fields describe). The term declares which blocks of each it touches.

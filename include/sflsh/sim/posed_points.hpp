@@ -29,7 +29,14 @@ class PosedPoints {
   /// surface_weights, basis rows interpolated through (surface_tet, surface_bary).
   static PosedPoints at_surface(const Avatar& avatar);
 
+  /// The points `rows` (indices into this set, in that order) as a set of their own.
+  PosedPoints subset(const std::vector<int>& rows) const;
+
   int size() const { return int(x_unposed_.rows()); }
+  /// World position of point p for configuration q (m).
+  Vec3 world_point(int p, const Configuration& q) const;
+  /// The bone with the largest skinning weight at point p (−1 if it has none).
+  int dominant_bone(int p) const;
   /// #P by 3 unposed rest positions x̄ (m).
   const Points& unposed() const { return x_unposed_; }
 

@@ -45,7 +45,8 @@ class Simulator {
   const Configuration& state(int body = 0) const { return state_.bodies.at(body).q; }
   const Configuration& previous_state(int body = 0) const { return state_.bodies.at(body).q_prev; }
   double time() const { return state_.time; }
-  const Avatar& avatar(int body = 0) const { return *model_->bodies().at(body).avatar; }
+  /// A body's avatar (throws for a rigid object).
+  const Avatar& avatar(int body = 0) const;
   /// Global layout of a body's DoFs.
   const DofLayout& layout(int body = 0) const { return model_->bodies().at(body).layout; }
 

@@ -1,0 +1,96 @@
+#pragma once
+// Rigid ↔ flesh contact through a signed distance field (seed §5; DESIGN.md
+// §4; issue 10). Samples of the body's skin, embedded in their tets so that
+// their world position x_p(q) follows the bones and the soft DoFs z
+// (posed_points.hpp), are pushed out of a rigid object's field φ by a
+// quadratic penalty on penetration:
+//   E = Σ_p ½ k min(φ(x_p), 0)²,   φ(x) = φ_local(T⁻¹ x),  T = the object's pose.
+// Gradient k φ ∇φᵀ J_p (exact); Hessian Gauss–Newton k J_pᵀ ∇φ ∇φᵀ J_p (PSD),
+// J_p = ∂x_p/∂δ. It acts on the soft tissue directly and on the skeleton
+// through the coupled solve.
+//
+// The object is either
+//   * static or kinematic: a named world frame of the step inputs
+//     (StepInputs::frames[object]) gives T at t + h; the term is bound to the
+//     body alone;
+//   * dynamic: a rigid-object body of the model (model.hpp), bound second;
+//     T = G_object · shape_in_frame at the current iterate, and the term also
+//     fills the object's 6 DoFs: ∂φ/∂ω = −x × ∇φ, ∂φ/∂v = −∇φ (the tangent
+//     of configuration.hpp: a point of the object moves by ω × x + v at first
+//     order, whatever the pivot), so the forces on body and object are equal
+//     and opposite and momentum is conserved.
+//
+// Broad phase (begin_step): the samples are grouped into clusters (dominant
+// bone × a cell of `cluster_size` in the unposed space) with a bounding
+// sphere; a cluster is kept only if φ at its centre, carried by its bone at
+// time t, is below its radius plus slack (skinning blend, soft displacement,
+// the motion over the step); then each kept sample's exact position at t is
+// tested against the margin. Newton iterations evaluate only these
+// candidates, so the cost follows the samples near the object, not the skin size.
+#include <string>
+#include <vector>
+
+#include "sflsh/geometry/sdf.hpp"
+#include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/posed_points.hpp"
+
+namespace sflsh {
+
+struct SdfContactOptions {
+  double stiffness = 2.0e4;  ///< k, N/m per sample
+  /// Candidate margin (m): a sample enters the step's contact set when φ at
+  /// time t is below margin + twice its displacement over the last step.
+  double margin = 0.01;
+  /// Broad-phase slack (m) added to every cluster's radius for linear blend
+  /// skinning and soft displacement away from the dominant bone's rigid motion.
+  double cluster_slack = 0.05;
+  double cluster_size = 0.1;  ///< m, cluster cell in the unposed space
+};
+
+class SdfContactTerm : public EnergyTerm {
+ public:
+  /// `samples`: the body's contact points (e.g. skin_contact_samples());
+  /// `field` in the object's shape frame, placed by pose · shape_in_frame
+  /// where pose is the world frame `object` (static/kinematic) or, when
+  /// `dynamic_object`, the configuration of the term's second bound body.
+  SdfContactTerm(std::string object, PosedPoints samples, geometry::SdfPtr field, const Isometry& shape_in_frame,
+                 bool dynamic_object, const SdfContactOptions& options = {});
+  std::string name() const override { return "contact:" + object_; }
+  std::unique_ptr<TermCache> make_cache() const override;
+  void begin_step(const StepContext& ctx) const override;
+  bool active(const StepContext& ctx) const override;
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
+  /// "force" (3, N: what the object exerts on the body, world), "active_samples"
+  /// (1: samples with φ < 0) and "max_penetration" (1, m) at the final q.
+  std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
+
+  const PosedPoints& samples() const { return samples_; }
+  const std::string& object() const { return object_; }
+  bool dynamic_object() const { return dynamic_; }
+  /// The field's world pose (step frame) for this context: from the frame or the object's iterate.
+  Isometry field_pose(const StepContext& ctx) const;
+  /// Candidate samples of the current step (after begin_step).
+  const std::vector<int>& candidates(const StepContext& ctx) const;
+
+ private:
+  struct Cluster {
+    int bone = 0;
+    Vec3 center = Vec3::Zero();  ///< unposed, m
+    double radius = 0;           ///< m, slack included
+    std::vector<int> samples;
+  };
+  std::string object_;
+  PosedPoints samples_;
+  geometry::SdfPtr field_;
+  Isometry shape_in_frame_;
+  bool dynamic_ = false;
+  SdfContactOptions options_;
+  std::vector<Cluster> clusters_;
+};
+
+/// The skin vertices of `avatar` to use as contact samples: every vertex
+/// (spacing ≤ 0), or one vertex per cubic cell of `spacing` m in the unposed
+/// space (the one nearest the cell's centre), so that density is uniform.
+PosedPoints skin_contact_samples(const Avatar& avatar, double spacing = 0.0);
+
+}  // namespace sflsh

@@ -1,0 +1,200 @@
+#include "sflsh/sim/energies/sdf_contact.hpp"
+
+#include <cmath>
+#include <algorithm>
+#include <map>
+#include <tuple>
+
+#include "sflsh/core/error.hpp"
+
+namespace sflsh {
+namespace {
+
+struct ContactCache : TermCache {
+  std::vector<int> candidates;
+  Isometry frame_pose = Isometry::Identity();  // static/kinematic: the field's pose at t + h
+};
+
+ContactCache& contact_cache(const StepContext& ctx, const std::string& name) {
+  require(ctx.cache != nullptr, name, ": no cache (call begin_step through begin_term_step or the integrator)");
+  return static_cast<ContactCache&>(*ctx.cache);
+}
+
+/// Rotation angle (rad) of R.
+double rotation_angle(const Mat3& R) { return std::acos(std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0)); }
+
+}  // namespace
+
+SdfContactTerm::SdfContactTerm(std::string object, PosedPoints samples, geometry::SdfPtr field,
+                               const Isometry& shape_in_frame, bool dynamic_object, const SdfContactOptions& o)
+    : object_(std::move(object)),
+      samples_(std::move(samples)),
+      field_(std::move(field)),
+      shape_in_frame_(shape_in_frame),
+      dynamic_(dynamic_object),
+      options_(o) {
+  require(field_ != nullptr, "contact with '", object_, "': no field");
+  require(o.stiffness >= 0 && std::isfinite(o.stiffness), "contact with '", object_, "': stiffness ", o.stiffness,
+          " N/m, expected >= 0");
+  require(o.margin >= 0 && o.cluster_slack >= 0 && o.cluster_size > 0, "contact with '", object_,
+          "': margin, slack must be >= 0 and the cluster size > 0");
+  // Clusters: samples by dominant bone and unposed cell.
+  std::map<std::tuple<int, long, long, long>, std::vector<int>> cells;
+  for (int p = 0; p < samples_.size(); ++p) {
+    const Vec3 x = samples_.unposed().row(p).transpose();
+    cells[{samples_.dominant_bone(p), std::lround(std::floor(x.x() / o.cluster_size)),
+           std::lround(std::floor(x.y() / o.cluster_size)), std::lround(std::floor(x.z() / o.cluster_size))}]
+        .push_back(p);
+  }
+  for (auto& [key, members] : cells) {
+    Cluster c;
+    c.bone = std::get<0>(key);
+    for (int p : members) c.center += samples_.unposed().row(p).transpose();
+    c.center /= double(members.size());
+    for (int p : members) c.radius = std::max(c.radius, (samples_.unposed().row(p).transpose() - c.center).norm());
+    c.radius += o.cluster_slack;
+    c.samples = std::move(members);
+    clusters_.push_back(std::move(c));
+  }
+}
+
+std::unique_ptr<TermCache> SdfContactTerm::make_cache() const { return std::make_unique<ContactCache>(); }
+
+const std::vector<int>& SdfContactTerm::candidates(const StepContext& ctx) const {
+  return contact_cache(ctx, name()).candidates;
+}
+
+Isometry SdfContactTerm::field_pose(const StepContext& ctx) const {
+  if (!dynamic_) return contact_cache(ctx, name()).frame_pose;
+  require(ctx.bound.size() == 2 && ctx.bound[1].q != nullptr, name(), ": the object's body is not bound");
+  return ctx.bound[1].q->bones[0] * shape_in_frame_;
+}
+
+void SdfContactTerm::begin_step(const StepContext& ctx) const {
+  ContactCache& c = contact_cache(ctx, name());
+  c.candidates.clear();
+  // The field's pose at time t (the broad phase's reference) and how far the
+  // object may move over the step.
+  const geometry::Aabb local = field_->bounds();
+  const double extent = !local.is_unbounded() ? 0.5 * (local.max - local.min).norm() : 1.0;
+  Isometry T;
+  double object_motion = 0;
+  if (dynamic_) {
+    require(ctx.bound.size() == 2, name(), ": a dynamic object's contact is bound to the body and the object");
+    const Isometry& G = ctx.bound[1].q_prev->bones[0];
+    T = G * shape_in_frame_;
+    if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
+      const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];
+      object_motion = 2 * ((G.translation() - Gp.translation()).norm() +
+                           rotation_angle(G.linear() * Gp.linear().transpose()) * extent);
+    }
+  } else {
+    require(ctx.frames != nullptr, name(), ": the step has no world frames");
+    const auto it = ctx.frames->find(object_);
+    require(it != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
+    const WorldFrame& f = it->second;
+    T = f.pose * shape_in_frame_;
+    c.frame_pose = T;
+    object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
+  }
+  const Isometry T_inv = T.inverse();
+  const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
+                                         : ctx.bound[0];
+  const Configuration& qt = *b.q_prev;
+  const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
+  for (const Cluster& cl : clusters_) {
+    const Vec3 x = qt.bones[cl.bone] * cl.center;
+    const double motion = has_prev ? 2 * (x - b.q_prev2->bones[cl.bone] * cl.center).norm() : 0.0;
+    const double reach = options_.margin + motion + object_motion;
+    if (field_->distance(T_inv * x) > cl.radius + reach) continue;
+    for (int p : cl.samples)
+      if (field_->distance(T_inv * samples_.world_point(p, qt)) < reach) c.candidates.push_back(p);
+  }
+}
+
+bool SdfContactTerm::active(const StepContext& ctx) const { return !candidates(ctx).empty(); }
+
+double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
+  const std::vector<int>& cand = candidates(ctx);
+  const Isometry T = field_pose(ctx);
+  const Isometry T_inv = T.inverse();
+  const DofLayout& L = ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
+  const int ob = dynamic_ ? ctx.bound[1].layout.base : -1;
+  const double k = options_.stiffness;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  VecX g;
+  double E = 0;
+  for (int p : cand) {
+    const Vec3 x = samples_.world_point(p, q);
+    const geometry::SdfSample s = field_->evaluate(T_inv * x);
+    const double d = s.distance;
+    if (!(d < 0)) continue;
+    E += 0.5 * k * d * d;
+    if (!grad && !hess) continue;
+    const Vec3 n = T.linear() * s.gradient;  // ∂φ/∂x, world
+    samples_.local_jacobian(p, q, L, J, cols);
+    g.noalias() = J.transpose() * n;  // ∂φ/∂δ over the body's columns
+    Eigen::Matrix<double, 6, 1> go = Eigen::Matrix<double, 6, 1>::Zero();  // ∂φ/∂ξ_object
+    if (dynamic_) {
+      go.head<3>() = -x.cross(n);  // a point of the object moves by ω × x + v (configuration.hpp)
+      go.tail<3>() = -n;
+    }
+    const int m = int(cols.size());
+    if (grad) {
+      for (int a = 0; a < m; ++a) (*grad)[cols[a]] += k * d * g[a];
+      if (dynamic_) grad->segment<6>(ob) += k * d * go;
+    }
+    if (hess) {
+      for (int a = 0; a < m; ++a)
+        for (int c = 0; c < m; ++c) (*hess)(cols[a], cols[c]) += k * g[a] * g[c];
+      if (dynamic_) {
+        hess->block<6, 6>(ob, ob) += k * go * go.transpose();
+        for (int a = 0; a < m; ++a)
+          for (int i = 0; i < 6; ++i) {
+            const double v = k * g[a] * go[i];
+            (*hess)(cols[a], ob + i) += v;
+            (*hess)(ob + i, cols[a]) += v;
+          }
+      }
+    }
+  }
+  return E;
+}
+
+std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const Configuration& q) const {
+  const Isometry T = field_pose(ctx);
+  const Isometry T_inv = T.inverse();
+  Vec3 force = Vec3::Zero();
+  int active = 0;
+  double depth = 0;
+  for (int p : candidates(ctx)) {
+    const geometry::SdfSample s = field_->evaluate(T_inv * samples_.world_point(p, q));
+    if (!(s.distance < 0)) continue;
+    force -= options_.stiffness * s.distance * (T.linear() * s.gradient);
+    ++active;
+    depth = std::max(depth, -s.distance);
+  }
+  return {{"force", "N", force}, {"active_samples", "", VecX::Constant(1, active)},
+          {"max_penetration", "m", VecX::Constant(1, depth)}};
+}
+
+PosedPoints skin_contact_samples(const Avatar& avatar, double spacing) {
+  PosedPoints all = PosedPoints::at_surface(avatar);
+  if (!(spacing > 0)) return all;
+  // One vertex per cell: the one nearest the cell's centre.
+  std::map<std::tuple<long, long, long>, std::pair<double, int>> best;
+  for (int p = 0; p < all.size(); ++p) {
+    const Vec3 x = all.unposed().row(p).transpose();
+    const Vec3 cell = (x / spacing).array().floor();
+    const double d = (x - (cell.array() + 0.5).matrix() * spacing).squaredNorm();
+    auto [it, fresh] = best.try_emplace({long(cell.x()), long(cell.y()), long(cell.z())}, d, p);
+    if (!fresh && d < it->second.first) it->second = {d, p};
+  }
+  std::vector<int> rows;
+  for (const auto& [cell, dp] : best) rows.push_back(dp.second);
+  std::sort(rows.begin(), rows.end());
+  return all.subset(rows);
+}
+
+}  // namespace sflsh

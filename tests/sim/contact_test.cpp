@@ -1,0 +1,435 @@
+// Contact terms (issue 10): SDF contact of skin samples against static and
+// dynamic rigid objects, bone-capsule contact between bodies. Gradients
+// against finite differences through the embedded-sample chain rule (bones
+// and z), Gauss–Newton Hessians against k Σ j jᵀ with j = ∂d/∂δ by finite
+// differences, the broad phase against brute force, momentum balance of the
+// forces, and the equilibrium / momentum figures on a small body.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+#include <set>
+
+#include "sflsh/core/rotation.hpp"
+#include "sflsh/geometry/primitive_sdfs.hpp"
+#include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/sim/momentum.hpp"
+#include "sflsh/sim/rigid_body_terms.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/skeleton_terms.hpp"
+#include "sflsh/sim/soft_tissue_terms.hpp"
+#include "sim/skeleton_fixture.hpp"
+#include "sim/synthetic_avatar.hpp"
+
+using namespace sflsh;
+
+namespace {
+
+constexpr double kH = 1.0 / 60.0;
+
+Avatar box(int handles = 6, int cells = 2, double cell = 0.04) {
+  test::SyntheticAvatarOptions o;
+  o.nx = o.nz = cells;
+  o.cell = cell;
+  o.handles = handles;
+  o.handle_radius = 0.1;
+  o.all_tets = false;
+  o.samples = 10;
+  Avatar a = test::make_synthetic_avatar(o);  // default: box x, z ∈ [−0.04, 0.04], y ∈ [0, 0.12]
+  a.joints_rest = test::make_tpose_skeleton().joints_rest;
+  a.capsules = {{3, Vec3(0, 0.03, 0), Vec3(0, 0.09, 0), 0.03}};
+  return a;
+}
+
+Isometry small_motion(std::mt19937& rng, double angle, double shift) {
+  std::normal_distribution<double> n;
+  Isometry G = Isometry::Identity();
+  G.linear() = Eigen::AngleAxisd(angle * n(rng), Vec3(n(rng), n(rng), n(rng)).normalized()).toRotationMatrix();
+  G.translation() = shift * Vec3(n(rng), n(rng), n(rng));
+  return G;
+}
+
+/// A configuration near rest: bones moved slightly, z random (m).
+Configuration near_rest(const Avatar& a, std::mt19937& rng, const Isometry& base = Isometry::Identity()) {
+  Configuration q;
+  for (int j = 0; j < 24; ++j) q.bones.push_back(base * small_motion(rng, 0.03, 0.003));
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  q.z = VecX(a.num_reduced());
+  for (int i = 0; i < q.z.size(); ++i) q.z[i] = u(rng);
+  return q;
+}
+
+DofLayout body_layout(const Avatar& a, bool bones_dynamic, int base = 0) {
+  DofLayout l;
+  l.bones_dynamic = bones_dynamic;
+  l.num_reduced = a.num_reduced();
+  l.bone_pivots = a.joints_rest;
+  l.base = base;
+  return l;
+}
+
+DofLayout rigid_layout(int base) {
+  DofLayout l;
+  l.num_bones = 1;
+  l.bones_dynamic = true;
+  l.num_reduced = 0;
+  l.bone_pivots = Points::Zero(1, 3);
+  l.base = base;
+  return l;
+}
+
+/// A context binding the given bodies (configurations at t and t − h) with their local layouts.
+struct Bound {
+  const Avatar* avatar;
+  DofLayout layout;
+  Configuration q, q_prev, q_prev2;
+};
+StepContext bind_bodies(std::vector<Bound>& bodies, const std::map<std::string, WorldFrame>* frames) {
+  StepContext ctx;
+  ctx.avatar = bodies[0].avatar;
+  ctx.layout = bodies[0].layout;
+  ctx.h = kH;
+  ctx.q_prev = bodies[0].q_prev;
+  ctx.q_prev2 = bodies[0].q_prev2;
+  ctx.frames = frames;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    ctx.bound.push_back({int(i), int(i), bodies[i].avatar, bodies[i].layout, &bodies[i].q, &bodies[i].q_prev,
+                         &bodies[i].q_prev2});
+  return ctx;
+}
+
+int total_size(const std::vector<Bound>& bodies) {
+  int n = 0;
+  for (const Bound& b : bodies) n += b.layout.size();
+  return n;
+}
+
+/// E at the bodies retracted by the global local-system step δ.
+double energy_at(const EnergyTerm& term, StepContext ctx, std::vector<Bound> bodies, const VecX& delta) {
+  std::vector<Configuration> q;
+  for (const Bound& b : bodies) q.push_back(retract(b.q, delta, b.layout));
+  for (size_t i = 0; i < bodies.size(); ++i) ctx.bound[i].q = &q[i];
+  return term.evaluate(ctx, q[0], nullptr, nullptr);
+}
+
+struct Derivatives {
+  double E;
+  VecX grad;
+  MatX hess;
+};
+Derivatives analytic(const EnergyTerm& term, const StepContext& ctx, const std::vector<Bound>& bodies) {
+  const int n = total_size(bodies);
+  Derivatives d{0, VecX::Zero(n), MatX::Zero(n, n)};
+  d.E = term.evaluate(ctx, bodies[0].q, &d.grad, &d.hess);
+  return d;
+}
+
+VecX fd_gradient(const EnergyTerm& term, const StepContext& ctx, const std::vector<Bound>& bodies, double eps) {
+  const int n = total_size(bodies);
+  VecX g(n);
+  for (int i = 0; i < n; ++i) {
+    VecX d = VecX::Zero(n);
+    d[i] = eps;
+    g[i] = (energy_at(term, ctx, bodies, d) - energy_at(term, ctx, bodies, -d)) / (2 * eps);
+  }
+  return g;
+}
+
+double rel(const VecX& a, const VecX& b) { return (a - b).norm() / std::max(1e-12, b.norm()); }
+
+TEST(SdfContact, GradientAndHessianAgainstAStaticSphereMatchFiniteDifferences) {
+  const Avatar a = box();
+  auto sphere = std::make_shared<geometry::SphereSdf>(0.05);
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = Vec3(0.01, 0.12 + 0.05 - 0.015, 0.005);  // 1.5 cm into the top
+  const double k = 3.0e4;
+  SdfContactOptions o;
+  o.stiffness = k;
+  const SdfContactTerm term("ball", PosedPoints::at_surface(a), sphere, Isometry::Identity(), false, o);
+  for (bool dynamic : {true, false}) {
+    std::mt19937 rng(dynamic ? 3 : 4);
+    std::vector<Bound> bodies{{&a, body_layout(a, dynamic), {}, {}, {}}};
+    bodies[0].q = near_rest(a, rng);
+    bodies[0].q_prev = bodies[0].q_prev2 = bodies[0].q;
+    StepContext ctx = bind_bodies(bodies, &frames);
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_TRUE(term.active(ctx));
+    const Derivatives d = analytic(term, ctx, bodies);
+    ASSERT_GT(d.E, 0);
+    EXPECT_LT(rel(d.grad, fd_gradient(term, ctx, bodies, 1e-7)), 1e-6) << "bones dynamic " << dynamic;
+    // Gauss–Newton: k Σ j jᵀ over the penetrating samples, j by finite differences of φ.
+    const int n = total_size(bodies);
+    MatX H = MatX::Zero(n, n);
+    const PosedPoints& P = term.samples();
+    for (int p = 0; p < P.size(); ++p) {
+      const Vec3 c = frames["ball"].pose.translation();
+      auto phi = [&](const VecX& delta) {
+        return (P.world_point(p, retract(bodies[0].q, delta, bodies[0].layout)) - c).norm() - 0.05;
+      };
+      if (phi(VecX::Zero(n)) >= 0) continue;
+      VecX j(n);
+      for (int i = 0; i < n; ++i) {
+        VecX e = VecX::Zero(n);
+        e[i] = 1e-7;
+        j[i] = (phi(e) - phi(-e)) / 2e-7;
+      }
+      H += k * j * j.transpose();
+    }
+    EXPECT_LT((d.hess - H).norm() / H.norm(), 1e-6) << "bones dynamic " << dynamic;
+  }
+}
+
+TEST(SdfContact, ADynamicObjectGetsTheOppositeForceAndTheChainRuleThroughItsPose) {
+  const Avatar a = box();
+  auto cube = std::make_shared<geometry::BoxSdf>(Vec3(0.03, 0.02, 0.05));
+  const double k = 2.0e4;
+  SdfContactOptions o;
+  o.stiffness = k;
+  // The box's shape frame sits off its body frame: exercises shape_in_frame.
+  Isometry shape_in_frame = Isometry::Identity();
+  shape_in_frame.translation() = Vec3(0.004, -0.002, 0.001);
+  shape_in_frame.linear() = Eigen::AngleAxisd(0.2, Vec3(0, 0, 1)).toRotationMatrix();
+  const SdfContactTerm term("lid", PosedPoints::at_surface(a), cube, shape_in_frame, true, o);
+  std::mt19937 rng(7);
+  std::vector<Bound> bodies{{&a, body_layout(a, true), {}, {}, {}}, {nullptr, rigid_layout(0), {}, {}, {}}};
+  bodies[1].layout.base = bodies[0].layout.size();
+  bodies[0].q = near_rest(a, rng);
+  Isometry G = Isometry::Identity();
+  G.linear() = Eigen::AngleAxisd(0.15, Vec3(1, 0, 0.3).normalized()).toRotationMatrix();
+  G.translation() = Vec3(0.01, 0.12 + 0.02 - 0.01, 0.0);
+  bodies[1].q.bones = {G};
+  bodies[1].q.z = VecX(0);
+  for (Bound& b : bodies) b.q_prev = b.q_prev2 = b.q;
+  StepContext ctx = bind_bodies(bodies, nullptr);
+  const auto cache = begin_term_step(term, ctx);
+  ASSERT_TRUE(term.active(ctx));
+  const Derivatives d = analytic(term, ctx, bodies);
+  ASSERT_GT(d.E, 0);
+  EXPECT_LT(rel(d.grad, fd_gradient(term, ctx, bodies, 1e-7)), 1e-6);
+  // Momentum: a common translation of both bodies changes nothing, so the
+  // translational gradients sum to zero (equal and opposite forces).
+  Vec3 sum = d.grad.segment<3>(bodies[1].layout.bone_offset(0) + 3);
+  for (int j = 0; j < 24; ++j) sum += d.grad.segment<3>(bodies[0].layout.bone_offset(j) + 3);
+  EXPECT_LT(sum.norm(), 1e-9 * d.grad.norm());
+  // The Hessian is PSD and symmetric.
+  EXPECT_LT((d.hess - d.hess.transpose()).norm(), 1e-12 * d.hess.norm());
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(d.hess).eigenvalues().minCoeff(), -1e-9 * d.hess.norm());
+  // The reported force is what the box exerts on the body: −(translational gradient of the body).
+  const auto rep = term.report(ctx, bodies[0].q);
+  ASSERT_EQ(rep[0].name, "force");
+  Vec3 body_force = Vec3::Zero();
+  for (int j = 0; j < 24; ++j) body_force -= d.grad.segment<3>(bodies[0].layout.bone_offset(j) + 3);
+  EXPECT_LT((rep[0].value - body_force).norm(), 1e-9 * body_force.norm());
+  EXPECT_LT(rep[0].value[1], 0) << "the lid, above the body, pushes it down";
+}
+
+TEST(SdfContact, BroadPhaseKeepsEveryPenetratingSampleAndNothingFar) {
+  const Avatar a = box();
+  auto plane = std::make_shared<geometry::PlaneSdf>(Vec3::UnitY(), 0.0);
+  std::map<std::string, WorldFrame> frames;
+  frames["floor"].pose.translation() = Vec3(0, 0.015, 0);  // the bottom 1.5 cm are under the floor
+  SdfContactOptions o;
+  o.cluster_size = 0.03;
+  const SdfContactTerm term("floor", PosedPoints::at_surface(a), plane, Isometry::Identity(), false, o);
+  std::mt19937 rng(11);
+  std::vector<Bound> bodies{{&a, body_layout(a, false), {}, {}, {}}};
+  bodies[0].q = near_rest(a, rng);
+  bodies[0].q_prev = bodies[0].q_prev2 = bodies[0].q;
+  StepContext ctx = bind_bodies(bodies, &frames);
+  auto cache = begin_term_step(term, ctx);
+  const std::vector<int>& cand = term.candidates(ctx);
+  int penetrating = 0, far = 0;
+  for (int p = 0; p < term.samples().size(); ++p) {
+    const double y = term.samples().world_point(p, bodies[0].q).y() - 0.015;
+    const bool is_candidate = std::find(cand.begin(), cand.end(), p) != cand.end();
+    if (y < 0) {
+      ++penetrating;
+      EXPECT_TRUE(is_candidate) << "sample " << p << " is under the floor but not a candidate";
+    }
+    if (y > 0.03) {
+      ++far;
+      EXPECT_FALSE(is_candidate) << "sample " << p << " is " << y << " m above the floor";
+    }
+  }
+  EXPECT_GT(penetrating, 0);
+  EXPECT_GT(far, 0);
+  // Far away: no candidates, the term is inactive.
+  frames["floor"].pose.translation() = Vec3(0, -1.0, 0);
+  cache = begin_term_step(term, ctx);
+  EXPECT_FALSE(term.active(ctx));
+  // A missing frame is named.
+  std::map<std::string, WorldFrame> none;
+  ctx.frames = &none;
+  EXPECT_THROW(begin_term_step(term, ctx), Error);
+}
+
+TEST(SdfContact, SampleSpacingKeepsOneVertexPerCell) {
+  const Avatar a = box();
+  const PosedPoints all = skin_contact_samples(a, 0.0);
+  EXPECT_EQ(all.size(), a.surface_rest.rows());
+  // The box surface has vertices every 4 cm; 8 cm cells keep one per cell: at most 2·2·2 per cell group.
+  const PosedPoints sparse = skin_contact_samples(a, 0.08);
+  EXPECT_LT(sparse.size(), all.size());
+  std::set<std::tuple<long, long, long>> cells;
+  for (int p = 0; p < sparse.size(); ++p) {
+    const Vec3 x = sparse.unposed().row(p).transpose() / 0.08;
+    EXPECT_TRUE(cells.insert({long(std::floor(x.x())), long(std::floor(x.y())), long(std::floor(x.z()))}).second);
+  }
+}
+
+TEST(CapsuleContact, GradientHessianAndMomentumBetweenTwoBodies) {
+  const Avatar a = box(), b = box();
+  const double k = 1.0e4;
+  const CapsuleContactTerm term(a, &b, {k, 2});
+  ASSERT_EQ(term.pairs().size(), 1u);
+  std::mt19937 rng(5);
+  std::vector<Bound> bodies{{&a, body_layout(a, true), {}, {}, {}}, {&b, body_layout(b, true), {}, {}, {}}};
+  for (Bound& bd : bodies) bd.layout.num_reduced = 0;  // Bones blocks only
+  bodies[1].layout.base = bodies[0].layout.size();
+  Isometry shift = Isometry::Identity();
+  shift.translation() = Vec3(0.05, 0.01, 0.002);  // axes 5 cm apart, radii 3 + 3 cm: 1 cm overlap
+  bodies[0].q = near_rest(a, rng);
+  bodies[1].q = near_rest(b, rng, shift);
+  for (Bound& bd : bodies) bd.q_prev = bd.q_prev2 = bd.q;
+  StepContext ctx = bind_bodies(bodies, nullptr);
+  const auto cache = begin_term_step(term, ctx);
+  ASSERT_TRUE(term.active(ctx));
+  const Derivatives d = analytic(term, ctx, bodies);
+  ASSERT_GT(d.E, 0);
+  EXPECT_LT(rel(d.grad, fd_gradient(term, ctx, bodies, 1e-7)), 1e-6);
+  // Independent overlap: |Δ axis points| − 0.06 from brute-force sampling of the two segments.
+  const Vec3 a0 = bodies[0].q.bones[3] * a.capsules[0].p0, a1 = bodies[0].q.bones[3] * a.capsules[0].p1;
+  const Vec3 b0 = bodies[1].q.bones[3] * b.capsules[0].p0, b1 = bodies[1].q.bones[3] * b.capsules[0].p1;
+  double dmin = 1e9;
+  for (int i = 0; i <= 400; ++i)
+    for (int j = 0; j <= 400; ++j)
+      dmin = std::min(dmin, ((a0 + (a1 - a0) * i / 400.0) - (b0 + (b1 - b0) * j / 400.0)).norm());
+  EXPECT_NEAR(d.E, 0.5 * k * (dmin - 0.06) * (dmin - 0.06), 1e-3 * d.E);
+  // GN Hessian = k j jᵀ with j = ∂d/∂δ = grad / (k d).
+  const double gap = dmin - 0.06;
+  const VecX j = d.grad / (k * gap);
+  EXPECT_LT((d.hess - k * j * j.transpose()).norm(), 1e-3 * d.hess.norm());
+  // Equal and opposite: translational and rotational gradients sum to zero.
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+  for (const Bound& bd : bodies)
+    for (int i = 0; i < 24; ++i) {
+      torque += d.grad.segment<3>(bd.layout.bone_offset(i));
+      force += d.grad.segment<3>(bd.layout.bone_offset(i) + 3);
+    }
+  EXPECT_LT(force.norm(), 1e-12 * d.grad.norm());
+  EXPECT_LT(torque.norm(), 1e-12 * d.grad.norm());
+}
+
+TEST(CapsuleContact, SelfContactSkipsAdjacentBonesAndPairsTouchingAtRest) {
+  Avatar a = box();
+  const Points J = a.joints_rest;
+  auto cap = [&](int bone, int child) {
+    return BoneCapsule{bone, Vec3(J.row(bone).transpose()), Vec3(J.row(child).transpose()), 0.02};
+  };
+  // Left hip→knee (1→4), left knee→ankle (4→7), right hip→knee (2→5), left elbow→wrist (18→20).
+  a.capsules = {cap(1, 4), cap(4, 7), cap(2, 5), cap(18, 20)};
+  const CapsuleContactTerm term(a, nullptr);
+  // 1–4: parent and child; 1–2: siblings under the pelvis (2 edges); both skipped.
+  // 4–2 (3 edges), and the elbow against each leg capsule, are kept.
+  const std::vector<std::pair<int, int>> expected{{1, 2}, {0, 3}, {1, 3}, {2, 3}};
+  std::vector<std::pair<int, int>> got = term.pairs();
+  std::sort(got.begin(), got.end());
+  std::vector<std::pair<int, int>> want = expected;
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(got, want);
+}
+
+/// A model: the box avatar (bones kinematic or dynamic) plus a dynamic ball
+/// (radius r, mass m) in contact through the skin.
+struct BallScene {
+  std::shared_ptr<const Model> model;
+  int avatar = 0, ball = 1;
+};
+BallScene ball_scene(const Avatar& a, bool bones_dynamic, double r, double m, const Vec3& gravity, int iterations) {
+  ModelOptions mo;
+  mo.h = kH;
+  mo.gravity = gravity;
+  mo.newton.iterations = iterations;
+  mo.newton.gradient_tolerance = 1e-10;
+  mo.newton.line_search = iterations > 1;
+  ModelBuilder mb(mo);
+  BallScene s;
+  auto avatar = std::make_shared<const Avatar>(a);
+  s.avatar = mb.add_body({"box", avatar, bones_dynamic});
+  s.ball = mb.add_body({"ball", nullptr, true});
+  add_soft_tissue_terms(mb, s.avatar, {true, 0.0});
+  if (bones_dynamic) {
+    SkeletonTermsOptions sk;
+    sk.body_mass = 2.0;
+    sk.tracking = false;  // external: would take momentum
+    sk.joint_limits = false;
+    add_skeleton_terms(mb, s.avatar, sk);
+  }
+  add_rigid_body_terms(mb, s.ball, m, Mat3::Identity() * 0.4 * m * r * r);
+  SdfContactOptions co;
+  co.stiffness = 2.0e4;
+  mb.add_term(std::make_shared<const SdfContactTerm>("ball", PosedPoints::at_surface(a),
+                                                     std::make_shared<geometry::SphereSdf>(r), Isometry::Identity(), true,
+                                                     co),
+              {s.avatar, s.ball});
+  s.model = mb.build();
+  return s;
+}
+
+TEST(ContactScene, ABallRestingOnAKinematicBodyIsHeldByItsWeight) {
+  // Skin vertices 1 cm apart on a 6 cm box top: the ball rests on several.
+  const Avatar a = box(6, 6, 0.01);
+  const double r = 0.05, m = 0.2;
+  const BallScene sc = ball_scene(a, false, r, m, Vec3(0, -9.81, 0), 3);
+  Simulator sim(sc.model);
+  State s = sim.scene_state();
+  s.bodies[sc.ball].q.bones[0].translation() = Vec3(0.005, 0.03 + r + 0.002, -0.003);  // 2 mm above the top
+  s.bodies[sc.ball].q_prev = s.bodies[sc.ball].q;
+  sim.set_state(s);
+  StepInputs in;
+  in.bodies.resize(2);
+  in.bodies[sc.avatar].bones = identity_bones();
+  StepReport rep;
+  for (int i = 0; i < 180; ++i) rep = sim.step(in);
+  Vec3 force = Vec3::Zero();
+  for (const TermQuantityReport& q : rep.quantities)
+    if (q.term == "contact:ball" && q.name == "force") force = Vec3(q.value[0], q.value[1], q.value[2]);
+  // The force on the body is the ball's weight (pointing down) within 2 %.
+  EXPECT_NEAR(force.y(), -m * 9.81, 0.02 * m * 9.81);
+  EXPECT_LT(std::hypot(force.x(), force.z()), 0.02 * m * 9.81);
+  const Vec3 v = (sim.state(sc.ball).bones[0].translation() - sim.previous_state(sc.ball).bones[0].translation()) / kH;
+  EXPECT_LT(v.norm(), 1e-3) << "the ball has not come to rest";
+}
+
+TEST(ContactScene, ABallThrownAtAFreeBodyConservesLinearMomentum) {
+  const Avatar a = box();
+  const double r = 0.03, m = 0.3;
+  const BallScene sc = ball_scene(a, true, r, m, Vec3::Zero(), 30);
+  Simulator sim(sc.model);
+  State s = sim.scene_state();
+  Isometry& G = s.bodies[sc.ball].q.bones[0];
+  G.translation() = Vec3(0.0, 0.06, 0.04 + r + 0.01);  // 1 cm in front of the box, thrown at it
+  s.bodies[sc.ball].q_prev = s.bodies[sc.ball].q;
+  s.bodies[sc.ball].q_prev.bones[0].translation() -= Vec3(0, 0, -2.0) * kH;  // 2 m/s towards −z
+  sim.set_state(s);
+  StepInputs in;
+  in.bodies.resize(2);
+  in.bodies[sc.avatar].bones = identity_bones();
+  const Vec3 p0 = linear_momentum(*sc.model, sim.scene_state());
+  ASSERT_NEAR(p0.z(), -2.0 * m, 1e-9);
+  bool touched = false;
+  for (int i = 0; i < 30; ++i) {
+    const StepReport rep = sim.step(in);
+    for (const TermQuantityReport& q : rep.quantities)
+      if (q.name == "active_samples" && q.value[0] > 0) touched = true;
+  }
+  EXPECT_TRUE(touched);
+  const Vec3 p1 = linear_momentum(*sc.model, sim.scene_state());
+  EXPECT_LT((p1 - p0).norm(), 1e-6 * p0.norm()) << "p0 " << p0.transpose() << ", p1 " << p1.transpose();
+  // The ball slowed down: momentum went to the body.
+  const Vec3 vb = (sim.state(sc.ball).bones[0].translation() - sim.previous_state(sc.ball).bones[0].translation()) / kH;
+  EXPECT_GT(vb.z(), -1.9);
+}
+
+}  // namespace
