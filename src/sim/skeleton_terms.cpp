@@ -67,9 +67,14 @@ void add_skeleton_terms(std::vector<EnergyTermPtr>& terms, const Avatar& avatar,
     terms.push_back(std::make_unique<JointConstraint>(avatar, o.joint_stiffness_ratio, body_mass));
   if (o.joint_limits)
     terms.push_back(std::make_unique<JointLimit>(avatar, smpl_joint_ranges(), springs(o.limit_frequency_hz)));
-  if (o.tracking)
-    terms.push_back(std::make_unique<Tracking>(avatar, springs(o.tracking_frequency_hz),
-                                               body_mass * std::pow(2.0 * M_PI * o.tracking_frequency_hz, 2)));
+  require(o.root_force_limit >= 0 && std::isfinite(o.root_force_limit), "add_skeleton_terms: root force limit ",
+          o.root_force_limit, " N, expected >= 0");
+  if (o.tracking) {
+    std::vector<double> k_rot = springs(o.tracking_frequency_hz);
+    double k_pos = body_mass * std::pow(2.0 * M_PI * o.tracking_frequency_hz, 2);
+    if (!o.track_root) k_rot[0] = k_pos = 0;
+    terms.push_back(std::make_unique<Tracking>(avatar, std::move(k_rot), k_pos, o.root_force_limit));
+  }
 }
 
 void add_skeleton_terms(ModelBuilder& builder, int body, const SkeletonTermsOptions& options) {

@@ -44,6 +44,29 @@ TEST(Tracking, SpringValues) {
   EXPECT_NEAR(term.evaluate(ctx, q, nullptr, nullptr), 0.5 * k[16] * 0.09 + 0.5 * 1e4 * 5e-4, 1e-12);
 }
 
+TEST(Tracking, ForceLimitedRootSpringIsHuber) {
+  // Root 0.05 m off its target, k = 1e4 N/m, limit F = 100 N (d = 1 cm): the
+  // energy is F (|r| − d/2) = 100 · 0.045 = 4.5 J (½ k|r|² would be 12.5 J),
+  // the force F along r; inside d it is the plain spring.
+  const Avatar a = test::make_tpose_skeleton();
+  std::vector<double> no_rot(24, 0.0);
+  Tracking capped(a, no_rot, 1e4, 100.0), plain(a, no_rot, 1e4);
+  StepContext ctx = test::skeleton_context(a, test::bones_config(std::vector<Isometry>(24, Isometry::Identity())));
+  for (double off : {0.05, 0.004}) {
+    std::vector<Isometry> G(24, Isometry::Identity());
+    for (Isometry& g : G) g.translation() = Vec3(0, 0.6, 0.8) * off;  // |shift| = off
+    const Configuration q = test::bones_config(G);
+    const double expected = off > 0.01 ? 100.0 * (off - 0.005) : 0.5 * 1e4 * off * off;
+    EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), expected, 1e-12);
+    VecX g = VecX::Zero(ctx.layout.size());
+    capped.evaluate(ctx, q, &g, nullptr);
+    EXPECT_LT((g - test::fd_gradient(capped, ctx, q)).norm(), 1e-6 * g.norm());
+    const double force = g.segment<3>(3).norm();  // ∂E/∂v of the root bone
+    EXPECT_NEAR(force, off > 0.01 ? 100.0 : 1e4 * off, 1e-9);
+    if (off < 0.01) EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), plain.evaluate(ctx, q, nullptr, nullptr), 1e-15);
+  }
+}
+
 TEST(Tracking, DerivativesMatchFiniteDifferences) {
   const Avatar a = test::make_tpose_skeleton();
   Tracking term(a, stiffness_ramp(), 1e4);

@@ -38,6 +38,14 @@ struct SkeletonTermsOptions {
   /// (simulator.hpp, configuration.hpp): 1.5 mm / 0.004 rad max joint error on
   /// a 1 Hz walk, 5.6 mm / 0.016 rad at 2 Hz.
   double tracking_frequency_hz = 20.0;
+  /// Track the root (pelvis) position and orientation too (false: only the
+  /// joint angles follow the motion; the body moves freely, e.g. a body
+  /// without a motion falling onto the floor).
+  bool track_root = true;
+  /// Largest force (N) the root position spring exerts; 0 = unlimited
+  /// (energies/tracking.hpp: a Huber spring). Scenes with body contact set it
+  /// so that contact, not the motion, decides where bodies meet.
+  double root_force_limit = 0.0;
 };
 
 /// Body mass (kg) from the closed skin surface of the avatar (volume by the

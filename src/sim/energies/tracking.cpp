@@ -7,11 +7,15 @@
 
 namespace sflsh {
 
-Tracking::Tracking(const Avatar& avatar, std::vector<double> rotation_stiffness, double position_stiffness)
+Tracking::Tracking(const Avatar& avatar, std::vector<double> rotation_stiffness, double position_stiffness,
+                   double position_force_limit)
     : joints_rest_(avatar.joints_rest),
       parents_(avatar.parents),
       k_rot_(std::move(rotation_stiffness)),
-      k_pos_(position_stiffness) {
+      k_pos_(position_stiffness),
+      force_limit_(position_force_limit) {
+  require(force_limit_ >= 0 && std::isfinite(force_limit_), "Tracking: root force limit must be >= 0 N, got ",
+          force_limit_);
   require(joints_rest_.rows() == Eigen::Index(parents_.size()) && !parents_.empty() && parents_[0] < 0,
           "Tracking: avatar needs a skeleton with root joint 0 (", joints_rest_.rows(), " rest joints, ",
           parents_.size(), " parents)");
@@ -35,7 +39,7 @@ void Tracking::residuals(const StepContext& ctx, const Configuration& q, std::ve
     const Mat3 T = rodrigues(ctx.target_pose.axis_angle.row(j).transpose());
     out.push_back(rotation_residual(q, j, T.transpose(), parents_[j], k_rot_[j] * Mat3::Identity()));
   }
-  if (k_pos_ > 0) {
+  if (k_pos_ > 0 && force_limit_ == 0) {
     const Vec3 root = joints_rest_.row(0).transpose();
     const Vec3 x = q.bones[0] * root;
     BoneResidual b;
@@ -45,6 +49,25 @@ void Tracking::residuals(const StepContext& ctx, const Configuration& q, std::ve
     b.J[0] = point_jacobian(x);
     out.push_back(b);
   }
+}
+
+double Tracking::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
+  double E = BoneLeastSquaresTerm::compute(ctx, q, grad, hess);
+  if (k_pos_ == 0 || force_limit_ == 0) return E;
+  // The Huber root spring (header comment).
+  const Vec3 root = joints_rest_.row(0).transpose();
+  const Vec3 x = q.bones[0] * root;
+  const Vec3 r = x - (root + ctx.target_pose.translation);
+  const double n = r.norm(), d = force_limit_ / k_pos_;
+  const bool inner = n <= d;
+  E += inner ? 0.5 * k_pos_ * n * n : force_limit_ * (n - 0.5 * d);
+  if (!ctx.layout.bones_dynamic) return E;
+  const Mat36 J = point_jacobian(x);
+  const double w = inner ? k_pos_ : force_limit_ / n;  // ∂E/∂r = w r
+  const int o = ctx.layout.bone_offset(0);
+  if (grad) grad->segment<6>(o) += J.transpose() * (w * r);
+  if (hess) hess->block<6, 6>(o, o) += w * J.transpose() * J;
+  return E;
 }
 
 }  // namespace sflsh

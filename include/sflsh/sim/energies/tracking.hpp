@@ -12,6 +12,13 @@
 // √(k/I); add_skeleton_terms sets k_j = I_j (2π f)² from each joint's subtree
 // inertia so every joint tracks with the same frequency f (a constant target
 // acceleration a is then followed with a lag of a/(2π f)²).
+//
+// Force limit (scenes with contact): with position_force_limit F > 0 the root
+// position spring becomes a Huber spring, ½ k|r|² for |r| ≤ d = F/k and
+// F (|r| − d/2) beyond, so the motion pulls the body along its path with at
+// most F newtons: a body walking into another is stopped by contact instead
+// of being pushed through it by an unbounded spring. Hessian beyond d: the
+// secant (F/|r|) JᵀJ (PSD).
 #include <vector>
 
 #include "sflsh/sim/energies/bone_residual.hpp"
@@ -23,15 +30,20 @@ class Tracking : public BoneLeastSquaresTerm {
   /// Rotation spring stiffness per joint (`rotation_stiffness`, #J, N·m/rad;
   /// 0 = not tracked; entry 0 = root orientation) and the root position
   /// spring (`position_stiffness`, N/m; 0 = off).
-  Tracking(const Avatar& avatar, std::vector<double> rotation_stiffness, double position_stiffness);
+  /// `position_force_limit` (N, 0 = none): see the header comment.
+  Tracking(const Avatar& avatar, std::vector<double> rotation_stiffness, double position_stiffness,
+           double position_force_limit = 0.0);
   std::string name() const override { return "tracking"; }
+  /// The rotation springs, and the root position spring when it has no force limit.
   void residuals(const StepContext& ctx, const Configuration& q, std::vector<BoneResidual>& out) const override;
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
  private:
   Points joints_rest_;
   std::vector<int> parents_;
   std::vector<double> k_rot_;
   double k_pos_;
+  double force_limit_;
 };
 
 }  // namespace sflsh
