@@ -44,6 +44,12 @@ struct Window {
       u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
     }
   }
+  /// Grows to hold `other`, but by at most `margin` beyond this window per side.
+  void add_within(const Window& other, double margin) {
+    if (other.u0 > other.u1) return;  // empty
+    u0 = std::min(u0, std::max(other.u0, u0 - margin)), u1 = std::max(u1, std::min(other.u1, u1 + margin));
+    v0 = std::min(v0, std::max(other.v0, v0 - margin)), v1 = std::max(v1, std::min(other.v1, v1 + margin));
+  }
   // A flat or single-point mesh still gets a finite, non-zero window.
   double width() const { return std::max(u1 - u0, 1e-6); }
   double height() const { return std::max(v1 - v0, 1e-6); }
@@ -61,9 +67,11 @@ struct Canvas {
   }
 };
 
-/// Screen placement of a view: pixel = (ox + s*u, oy - s*v) in canvas pixels.
+/// Screen placement of a view: pixel = (ox + s*u, oy - s*v) in canvas pixels;
+/// only pixels in [x0, x1) × [y0, y1) are drawn.
 struct Placement {
   double ox, oy, s;
+  int x0 = 0, y0 = 0, x1 = std::numeric_limits<int>::max(), y1 = std::numeric_limits<int>::max();
 };
 
 /// Shades a point with unit normal n (world) and albedo c. Key light from the
@@ -97,10 +105,13 @@ void draw_mesh(Canvas& canvas, const Points& V, const Triangles& F, const Points
     const double x0 = S(i0, 0), y0 = S(i0, 1), x1 = S(i1, 0), y1 = S(i1, 1), x2 = S(i2, 0), y2 = S(i2, 1);
     const double area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
     if (std::abs(area) < 1e-12) continue;
-    const int xa = std::max(0, int(std::floor(std::min({x0, x1, x2}))));
-    const int xb = std::min(canvas.w - 1, int(std::ceil(std::max({x0, x1, x2}))));
-    const int ya = std::max(0, int(std::floor(std::min({y0, y1, y2}))));
-    const int yb = std::min(canvas.h - 1, int(std::ceil(std::max({y0, y1, y2}))));
+    // Clamped in double first (a huge patch's corners lie far outside int range);
+    // a triangle outside the clip rectangle gets an empty range.
+    const auto clamp = [](double x, int lo, int hi) { return int(std::clamp(x, double(lo), double(hi))); };
+    const int xa = clamp(std::floor(std::min({x0, x1, x2})), std::max(0, at.x0), std::min(canvas.w, at.x1));
+    const int xb = clamp(std::ceil(std::max({x0, x1, x2})), std::max(0, at.x0) - 1, std::min(canvas.w, at.x1) - 1);
+    const int ya = clamp(std::floor(std::min({y0, y1, y2})), std::max(0, at.y0), std::min(canvas.h, at.y1));
+    const int yb = clamp(std::ceil(std::max({y0, y1, y2})), std::max(0, at.y0) - 1, std::min(canvas.h, at.y1) - 1);
     const double inv = 1.0 / area;
     for (int y = ya; y <= yb; ++y) {
       const double py = y + 0.5;
@@ -232,8 +243,10 @@ Image render_strip(const std::vector<StripFrame>& frames, const Triangles& F, co
   require(options.height >= 64, "render_strip: height must be at least 64 pixels, got ", options.height);
   require(options.supersample >= 1 && options.supersample <= 8, "render_strip: supersample must be in 1..8, got ",
           options.supersample);
+  require(std::isfinite(options.solid_margin) && options.solid_margin >= 0,
+          "render_strip: solid_margin must be finite and >= 0, got ", options.solid_margin);
   const Camera cam = camera_for(options.view);
-  Window win;
+  Window win, solid_win;
   double vmin = std::numeric_limits<double>::infinity(), vmax = -vmin;
   for (size_t i = 0; i < frames.size(); ++i) {
     const StripFrame& fr = frames[i];
@@ -242,9 +255,15 @@ Image render_strip(const std::vector<StripFrame>& frames, const Triangles& F, co
             " values, expected one per vertex (", fr.vertices.rows(), ")");
     require(fr.values.allFinite(), "render_strip: frame ", i, " values contain NaN or Inf");
     win.add(fr.vertices, cam);
+    for (const SolidSurface& solid : fr.solids) {
+      check_surface_arrays(solid.vertices, solid.faces, "render_strip (solid)");
+      require(solid.color.allFinite(), "render_strip: frame ", i, " has a solid with a non-finite colour");
+      if (solid.frames_view) solid_win.add(solid.vertices, cam);
+    }
     vmin = std::min(vmin, fr.values.minCoeff());
     vmax = std::max(vmax, fr.values.maxCoeff());
   }
+  win.add_within(solid_win, options.solid_margin * std::max(win.width(), win.height()));
   if (std::isfinite(options.value_min)) vmin = options.value_min;
   if (std::isfinite(options.value_max)) vmax = options.value_max;
 
@@ -271,9 +290,13 @@ Image render_strip(const std::vector<StripFrame>& frames, const Triangles& F, co
   Canvas canvas(W_total * ss, H * ss, options.background);
   const double oy = top + s * win.v1;
   for (int i = 0; i < n; ++i) {
-    const double ox = pad + i * (panel_w + gap) - s * win.u0;
-    const Points colors = colormap_colors(options.colormap, frames[size_t(i)].values, vmin, vmax);
-    draw_mesh(canvas, frames[size_t(i)].vertices, F, colors, cam, {ox * ss, oy * ss, s * ss});
+    const StripFrame& fr = frames[size_t(i)];
+    const int px = pad + i * (panel_w + gap);
+    const double ox = px - s * win.u0;
+    const Placement at{ox * ss, oy * ss, s * ss, px * ss, top * ss, (px + panel_w) * ss, (H - bottom) * ss};
+    draw_mesh(canvas, fr.vertices, F, colormap_colors(options.colormap, fr.values, vmin, vmax), cam, at);
+    for (const SolidSurface& solid : fr.solids)
+      draw_mesh(canvas, solid.vertices, solid.faces, solid.color.transpose().replicate(solid.vertices.rows(), 1), cam, at);
   }
   Image img = downsample(canvas, ss);
 

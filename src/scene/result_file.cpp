@@ -2,11 +2,82 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "sflsh/core/error.hpp"
 
 namespace sflsh {
 namespace {
+
+constexpr const char* kShapes[] = {"plane", "sphere", "box", "capsule", "cylinder", "mesh"};
+constexpr const char* kKinds[] = {"static", "kinematic", "dynamic"};
+/// Largest |‖q‖ − 1| a stored quaternion may have (they are written normalized in float64).
+constexpr double kUnitTolerance = 1e-6;
+
+template <size_t N>
+bool one_of(const std::string& s, const char* const (&list)[N]) {
+  return std::find(std::begin(list), std::end(list), s) != std::end(list);
+}
+
+template <size_t N>
+std::string joined(const char* const (&list)[N]) {
+  std::string out;
+  for (const char* x : list) out += (out.empty() ? "" : ", ") + std::string(x);
+  return out;
+}
+
+std::string object_group(size_t o) { return "/objects/" + std::to_string(o); }
+
+/// Checks that `scene` fits a skin of V vertices; `where` starts every message
+/// (the file path). The writer and the reader share it.
+void check_scene(const ResultScene& scene, Eigen::Index V, const std::string& where) {
+  const auto& names = scene.body_names;
+  const auto& off = scene.body_vertex_offsets;
+  require(!names.empty() || off.empty(), where, ": /bodies/vertex_offsets given without /bodies/names");
+  if (!names.empty()) {
+    require(off.size() == names.size() + 1, where, ": /bodies/names has ", names.size(), " bodies, so /bodies/vertex_offsets needs ",
+            names.size() + 1, " entries, got ", off.size());
+    require(off.front() == 0 && off.back() == V, where, ": /bodies/vertex_offsets must start at 0 and end at the ", V,
+            " skin vertices, got ", off.front(), " ... ", off.back());
+    for (size_t b = 0; b + 1 < off.size(); ++b)
+      require(off[b] <= off[b + 1], where, ": /bodies/vertex_offsets must not decrease (entry ", b + 1, ")");
+  }
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const ObjectTrack& t = scene.objects[o];
+    const std::string at = where + ": " + object_group(o) + " ('" + t.name + "')";
+    require(one_of(t.shape, kShapes), at, ": shape '", t.shape, "' is not one of ", joined(kShapes));
+    require(one_of(t.kind, kKinds), at, ": kind '", t.kind, "' is not one of ", joined(kKinds));
+    require(t.vertices.rows() > 0 && t.faces.rows() > 0, at, ": needs a surface (", t.vertices.rows(), " vertices, ",
+            t.faces.rows(), " faces)");
+    require(t.vertices.allFinite(), at, ": vertices contain NaN or Inf");
+    require(t.faces.minCoeff() >= 0 && t.faces.maxCoeff() < t.vertices.rows(), at, ": face indices must lie in [0, ",
+            t.vertices.rows(), ")");
+  }
+}
+
+/// Pose as 7 numbers: position (m), then the unit quaternion w x y z (w >= 0).
+void pose_to_row(const Isometry& T, double* out, const std::string& what) {
+  const Mat3 R = T.linear();
+  require(T.translation().allFinite() && R.allFinite(), what, " is not finite");
+  require((R.transpose() * R - Mat3::Identity()).norm() < kUnitTolerance && R.determinant() > 0, what,
+          " is not a rigid motion (its linear part is not a rotation)");
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  if (q.w() < 0) q.coeffs() *= -1.0;
+  const Vec3 p = T.translation();
+  const double row[7] = {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()};
+  std::copy(row, row + 7, out);
+}
+
+Isometry pose_from_row(const double* in, const std::string& what) {
+  Eigen::Quaterniond q(in[3], in[4], in[5], in[6]);
+  require(std::abs(q.norm() - 1.0) < kUnitTolerance, what, ": quaternion (w x y z) has norm ", q.norm(),
+          ", expected a unit quaternion");
+  Isometry T = Isometry::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Vec3(in[0], in[1], in[2]);
+  return T;
+}
 
 std::vector<Points> unstack(const std::vector<double>& flat, const std::vector<std::int64_t>& shape) {
   std::vector<Points> out(shape[0]);
@@ -20,26 +91,88 @@ std::vector<Points> unstack(const std::vector<double>& flat, const std::vector<s
 
 }  // namespace
 
+ResultScene result_scene(const SimulationResult& r) {
+  ResultScene s{r.body_names, r.body_vertex_offsets, r.objects};
+  for (ObjectTrack& t : s.objects) t.poses.clear();
+  return s;
+}
+
+int num_bodies(const SimulationResult& r) { return r.body_names.empty() ? 1 : int(r.body_names.size()); }
+
+std::string describe_scene_parts(const SimulationResult& r) {
+  std::ostringstream o;
+  if (!r.body_names.empty()) {
+    o << "bodies:";
+    for (size_t b = 0; b < r.body_names.size(); ++b) {
+      o << (b ? ", " : " ") << r.body_names[b];
+      if (r.body_vertex_offsets.size() == r.body_names.size() + 1)
+        o << " (" << r.body_vertex_offsets[b + 1] - r.body_vertex_offsets[b] << " skin vertices)";
+    }
+    o << "\n";
+  }
+  if (!r.objects.empty()) {
+    o << "objects:";
+    for (size_t i = 0; i < r.objects.size(); ++i)
+      o << (i ? ", " : " ") << r.objects[i].name << " (" << r.objects[i].shape << ", " << r.objects[i].kind << ")";
+    o << "\n";
+  }
+  return o.str();
+}
+
 ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, const Points& surface_rest,
-                           int num_reduced, bool target_pelvis)
-    : file_(std::make_unique<io::Hdf5File>(path, io::Hdf5File::Mode::Write)), target_pelvis_(target_pelvis) {
+                           int num_reduced, bool target_pelvis, const ResultScene& scene)
+    : target_pelvis_(target_pelvis) {
+  const std::int64_t V = surface_rest.rows();
+  require(faces.rows() == 0 || (faces.minCoeff() >= 0 && faces.maxCoeff() < V), path,
+          ": skin face indices must lie in [0, ", V, ")");
+  check_scene(scene, V, path);
+  file_ = std::make_unique<io::Hdf5File>(path, io::Hdf5File::Mode::Write);
+  num_vertices_ = V;
+  num_joints_ = 24 * Eigen::Index(std::max<size_t>(1, scene.body_names.size()));
+  num_reduced_ = num_reduced;
   auto& f = *file_;
   f.write_matrix("/surface/faces", faces);
   f.write_matrix("/surface/rest", surface_rest);
-  const std::int64_t V = surface_rest.rows();
+  if (!scene.body_names.empty()) {
+    f.write_strings("/bodies/names", scene.body_names);
+    f.write_nd("/bodies/vertex_offsets", scene.body_vertex_offsets.data(),
+               {std::int64_t(scene.body_vertex_offsets.size())});
+  }
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    const ObjectTrack& t = scene.objects[o];
+    const std::string g = object_group(o);
+    f.write_string(g + "/name", t.name);
+    f.write_string(g + "/shape", t.shape);
+    f.write_string(g + "/kind", t.kind);
+    f.write_matrix(g + "/vertices", t.vertices);
+    f.write_matrix(g + "/faces", t.faces);
+    object_names_.push_back(t.name);
+  }
   f.create_appendable("/frames/time", {});
   f.create_appendable("/frames/step_ms", {});
   f.create_appendable("/frames/positions", {V, 3}, true);
   f.create_appendable("/frames/displacement", {V, 3}, true);
-  f.create_appendable("/frames/joints", {24, 3});
+  f.create_appendable("/frames/joints", {num_joints_, 3});
   f.create_appendable("/frames/reduced", {num_reduced});
   if (target_pelvis_) f.create_appendable("/frames/target_pelvis", {3});
+  if (!object_names_.empty()) f.create_appendable("/frames/object_poses", {std::int64_t(object_names_.size()), 7});
 }
 
 ResultWriter::~ResultWriter() = default;
 
 void ResultWriter::add_frame(const FrameData& fr) {
   auto& f = *file_;
+  const std::string at = f.path() + ": frame " + std::to_string(frames_);
+  require(fr.positions.rows() == num_vertices_ && fr.displacement.rows() == num_vertices_, at, ": positions/displacement have ",
+          fr.positions.rows(), "/", fr.displacement.rows(), " rows, expected ", num_vertices_, " skin vertices");
+  require(fr.joints.rows() == num_joints_, at, ": joints has ", fr.joints.rows(), " rows, expected ", num_joints_,
+          " (24 per body)");
+  require(fr.reduced.size() == num_reduced_, at, ": reduced has ", fr.reduced.size(), " entries, expected ", num_reduced_);
+  require(fr.object_poses.size() == object_names_.size(), at, ": ", fr.object_poses.size(), " object poses for ",
+          object_names_.size(), " objects");
+  std::vector<double> poses(7 * object_names_.size());
+  for (size_t o = 0; o < object_names_.size(); ++o)
+    pose_to_row(fr.object_poses[o], &poses[7 * o], at + ": the pose of object '" + object_names_[o] + "'");
   f.append("/frames/time", &fr.time);
   f.append("/frames/step_ms", &fr.step_ms);
   f.append("/frames/positions", fr.positions.data());
@@ -47,6 +180,7 @@ void ResultWriter::add_frame(const FrameData& fr) {
   f.append("/frames/joints", fr.joints.data());
   f.append("/frames/reduced", fr.reduced.data());
   if (target_pelvis_) f.append("/frames/target_pelvis", fr.target_pelvis.data());
+  if (!object_names_.empty()) f.append("/frames/object_poses", poses.data());
   ++frames_;
 }
 
@@ -73,10 +207,22 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
   const int nr = r.frame_reduced.empty() ? 0 : int(r.frame_reduced[0].size());
   require(r.frame_target_pelvis.empty() || r.frame_target_pelvis.size() == r.frame_time.size(), path, ": ",
           r.frame_target_pelvis.size(), " target pelvis positions for ", r.frame_time.size(), " frames");
-  ResultWriter w(path, r.faces, r.surface_rest, nr, !r.frame_target_pelvis.empty());
-  for (size_t i = 0; i < r.frame_time.size(); ++i)
-    w.add_frame({r.frame_time[i], r.frame_step_ms[i], r.frame_positions[i], r.frame_displacement[i], r.frame_joints[i],
-                 r.frame_reduced[i], r.frame_target_pelvis.empty() ? Vec3(Vec3::Zero()) : r.frame_target_pelvis[i]});
+  for (const ObjectTrack& t : r.objects)
+    require(t.poses.size() == r.frame_time.size(), path, ": object '", t.name, "' has ", t.poses.size(),
+            " poses for ", r.frame_time.size(), " frames");
+  ResultWriter w(path, r.faces, r.surface_rest, nr, !r.frame_target_pelvis.empty(), result_scene(r));
+  for (size_t i = 0; i < r.frame_time.size(); ++i) {
+    FrameData fr;
+    fr.time = r.frame_time[i];
+    fr.step_ms = r.frame_step_ms[i];
+    fr.positions = r.frame_positions[i];
+    fr.displacement = r.frame_displacement[i];
+    fr.joints = r.frame_joints[i];
+    fr.reduced = r.frame_reduced[i];
+    if (!r.frame_target_pelvis.empty()) fr.target_pelvis = r.frame_target_pelvis[i];
+    for (const ObjectTrack& t : r.objects) fr.object_poses.push_back(t.poses[i]);
+    w.add_frame(fr);
+  }
   w.finish(r);
 }
 
@@ -84,7 +230,8 @@ SimulationResult read_simulation_result(const std::string& path) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
   require(f.has("/meta/format_version"), path, ": not an sflsh result file (dataset /meta/format_version is missing)");
   const double v = f.read_scalar("/meta/format_version");
-  require(v == kResultFormatVersion, path, ": dataset /meta/format_version is ", v, ", expected ", kResultFormatVersion);
+  require(v == 1 || v == kResultFormatVersion, path, ": dataset /meta/format_version is ", v, ", expected 1 to ",
+          kResultFormatVersion);
   SimulationResult r;
   r.avatar = f.read_string("/meta/avatar");
   r.motion = f.read_string("/meta/motion");
@@ -94,6 +241,39 @@ SimulationResult read_simulation_result(const std::string& path) {
   r.faces = f.read_int_matrix("/surface/faces", -1, 3);
   r.surface_rest = f.read_matrix("/surface/rest", -1, 3);
   const std::int64_t V = r.surface_rest.rows();
+  require(r.faces.rows() == 0 || (r.faces.minCoeff() >= 0 && r.faces.maxCoeff() < V), path,
+          ": dataset /surface/faces has indices outside [0, ", V, ")");
+  ResultScene scene;
+  if (f.has("/bodies/names")) {
+    scene.body_names = f.read_strings("/bodies/names");
+    const auto off = f.read_int_matrix("/bodies/vertex_offsets", -1, 1);
+    scene.body_vertex_offsets.assign(off.data(), off.data() + off.size());
+  } else {
+    require(!f.has("/bodies/vertex_offsets"), path, ": dataset /bodies/vertex_offsets given without /bodies/names");
+  }
+  std::int64_t O = 0;
+  if (f.has("/frames/object_poses")) {
+    const auto s = f.shape("/frames/object_poses");
+    require(s.size() == 3, path, ": dataset /frames/object_poses must have shape (frames, objects, 7)");
+    O = s[1];
+  }
+  for (std::int64_t o = 0; o < O; ++o) {
+    const std::string g = object_group(size_t(o));
+    require(f.has(g), path, ": /frames/object_poses holds ", O, " objects but group ", g, " is missing");
+    ObjectTrack t;
+    t.name = f.read_string(g + "/name");
+    t.shape = f.read_string(g + "/shape");
+    t.kind = f.read_string(g + "/kind");
+    t.vertices = f.read_matrix(g + "/vertices", -1, 3);
+    t.faces = f.read_int_matrix(g + "/faces", -1, 3);
+    scene.objects.push_back(std::move(t));
+  }
+  require(!f.has(object_group(size_t(O))), path, ": group ", object_group(size_t(O)), " has no poses in /frames/object_poses (",
+          O, " objects)");
+  check_scene(scene, V, path);
+  r.body_names = std::move(scene.body_names);
+  r.body_vertex_offsets = std::move(scene.body_vertex_offsets);
+  r.objects = std::move(scene.objects);
   MatXr t = f.read_matrix("/frames/time");
   const std::int64_t F = t.rows();
   r.frame_time.assign(t.data(), t.data() + F);
@@ -101,7 +281,15 @@ SimulationResult read_simulation_result(const std::string& path) {
   std::vector<std::int64_t> shape;
   r.frame_positions = unstack(f.read_nd("/frames/positions", {F, V, 3}, &shape), shape);
   r.frame_displacement = unstack(f.read_nd("/frames/displacement", {F, V, 3}, &shape), shape);
-  r.frame_joints = unstack(f.read_nd("/frames/joints", {F, 24, 3}, &shape), shape);
+  r.frame_joints = unstack(f.read_nd("/frames/joints", {F, 24 * std::int64_t(num_bodies(r)), 3}, &shape), shape);
+  if (O > 0) {
+    const std::vector<double> poses = f.read_nd("/frames/object_poses", {F, O, 7});
+    for (std::int64_t o = 0; o < O; ++o)
+      for (std::int64_t i = 0; i < F; ++i)
+        r.objects[size_t(o)].poses.push_back(pose_from_row(
+            &poses[size_t((i * O + o) * 7)], path + ": dataset /frames/object_poses, frame " + std::to_string(i) +
+                                                 ", object " + std::to_string(o)));
+  }
   MatXr red = f.read_matrix("/frames/reduced", F, -1);
   for (std::int64_t i = 0; i < F; ++i) r.frame_reduced.push_back(red.row(i).transpose());
   MatXr ms = f.read_matrix("/frames/step_ms", F, 1);

@@ -146,6 +146,39 @@ TEST(Render, StripDimensionsColorsAndBar) {
   EXPECT_THROW(render_strip(frames, F, opt), Error);
 }
 
+TEST(Render, StripSolidsWidenTheWindowOnlyWithinTheMargin) {
+  // Body: a ball of diameter 1 at the origin; solids: a green ball of radius
+  // 0.1 at x = 0.7 and a grey one at x = 3 (beyond the 0.5 m margin).
+  StripFrame fr;
+  Triangles F;
+  sphere(3, 0.5, Vec3::Zero(), fr.vertices, F);
+  fr.values = VecX::Zero(fr.vertices.rows());
+  StripOptions opt;
+  opt.height = 240;
+  const Image bare = render_strip({fr}, F, opt);
+  SolidSurface green, far;
+  sphere(2, 0.1, Vec3(0.7, 0, 0), green.vertices, green.faces);
+  green.color = Vec3(0.1, 0.8, 0.1);
+  sphere(2, 0.1, Vec3(3.0, 0, 0), far.vertices, far.faces);
+  fr.solids = {green, far};
+  const Image with = render_strip({fr}, F, opt);
+  // The body's diameter in pixels: the first run of non-background pixels
+  // along the middle row (the window is centred vertically).
+  const int y = opt.height / 2;
+  int x0 = 0;
+  while (x0 < bare.width && bare.pixel(x0, y) == opt.background) ++x0;
+  int d = 0;
+  while (x0 + d < bare.width && bare.pixel(x0 + d, y) != opt.background) ++d;
+  ASSERT_GT(d, 100);
+  // The window grew by half its size (0.5 m of a 1 m window), not to x = 3.1.
+  EXPECT_NEAR(with.width - bare.width, 0.5 * d, 2.0);
+  const Rgb8 g = with.pixel(x0 + int(1.2 * d), y);  // x = 0.7
+  EXPECT_GT(int(g[1]), int(g[0]) + 60);
+  // A solid that does not frame the view leaves the window alone.
+  for (auto& s : fr.solids) s.frames_view = false;
+  EXPECT_EQ(render_strip({fr}, F, opt).width, bare.width);
+}
+
 TEST(Colormap, KnownValues) {
   const Vec3 v0 = colormap_rgb(Colormap::Viridis, 0.0), v1 = colormap_rgb(Colormap::Viridis, 1.0);
   EXPECT_NEAR(v0[0] * 255, 68, 0.5);

@@ -66,7 +66,7 @@ TEST(ResultFile, UnfinishedStreamLeavesNoFile) {
   const SimulationResult r = small_result();
   {
     ResultWriter w(tmp.file("r.h5"), r.faces, r.surface_rest, 6);
-    w.add_frame({0.0, 1.0, r.frame_positions[0], r.frame_displacement[0], r.frame_joints[0], r.frame_reduced[0]});
+    w.add_frame({0.0, 1.0, r.frame_positions[0], r.frame_displacement[0], r.frame_joints[0], r.frame_reduced[0], Vec3::Zero(), {}});
     // no finish(): e.g. the simulation threw
   }
   EXPECT_FALSE(std::filesystem::exists(tmp.file("r.h5")));
@@ -80,4 +80,261 @@ TEST(ResultFile, RejectsOtherFiles) {
     f.commit();
   }
   EXPECT_THROW(read_simulation_result(tmp.file("x.h5")), Error);
+}
+
+// ---- scenes: several bodies and rigid objects (format version 2) ----------
+
+namespace {
+
+Isometry pose(double angle, const Vec3& axis, const Vec3& t) {
+  Isometry T = Isometry::Identity();
+  T.linear() = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
+/// Two bodies (a triangle each) and two objects with poses that differ per frame.
+SimulationResult scene_result() {
+  SimulationResult r;
+  r.avatar = "two.h5";
+  r.motion = "scene:bump.yaml";
+  r.dt = 1.0 / 120;
+  r.newton_iters = 3;
+  r.body_names = {"alice", "bob"};
+  r.body_vertex_offsets = {0, 3, 6};
+  r.faces.resize(2, 3);
+  r.faces << 0, 1, 2, 3, 5, 4;
+  r.surface_rest.resize(6, 3);
+  for (int i = 0; i < 18; ++i) r.surface_rest.data()[i] = 0.1 * i - 0.7;
+  ObjectTrack ball{"ball", "sphere", "dynamic", Points(), Triangles(), {}};
+  ball.vertices.resize(4, 3);
+  ball.vertices << 0.1, 0, 0, 0, 0.1, 0, 0, 0, 0.1, -0.05, -0.05, -0.05;
+  ball.faces.resize(4, 3);
+  ball.faces << 0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0;
+  ObjectTrack box{"crate", "box", "kinematic", Points::Constant(3, 3, 0.25), Triangles(), {}};
+  box.vertices(1, 0) = -0.25, box.vertices(2, 1) = -0.25;
+  box.faces.resize(1, 3);
+  box.faces << 2, 1, 0;
+  for (int f = 0; f < 3; ++f) {
+    r.frame_time.push_back(0.1 * f);
+    r.frame_step_ms.push_back(2.0 + f);
+    r.frame_positions.push_back(Points::Constant(6, 3, 0.5 + f));
+    r.frame_displacement.push_back(Points::Constant(6, 3, 0.002 * f));
+    Points J(48, 3);
+    for (int i = 0; i < J.size(); ++i) J.data()[i] = 0.01 * i + f;
+    r.frame_joints.push_back(J);
+    r.frame_reduced.push_back(VecX::LinSpaced(5, f, f + 1));
+    ball.poses.push_back(pose(0.4 * f + 0.1, Vec3(0, 0, 1), Vec3(1.0 + f, 0.2, -0.3 * f)));
+    box.poses.push_back(pose(-0.7 - 0.2 * f, Vec3(1, 2, -0.5), Vec3(-0.5, 0.1 * f, 2.0)));
+  }
+  r.objects = {ball, box};
+  r.num_frames = 3;
+  r.step_time = {0.1, 0.2};
+  r.step_energy = {1, 2};
+  r.step_grad_norm = {0.1, 0.2};
+  r.step_decrement = {0.01, 0.02};
+  r.step_outcome = {0, 2};
+  r.step_ms = {3, 4};
+  return r;
+}
+
+}  // namespace
+
+TEST(ResultFile, ScenesKeepBodiesObjectsAndPoses) {
+  test::TempDir tmp;
+  const SimulationResult r = scene_result();
+  write_simulation_result(r, tmp.file("s.h5"));
+  {
+    // The stored pose row of the ball at frame 2 from the closed form: a turn
+    // by θ = 0.9 about +Z is the quaternion (cos θ/2, 0, 0, sin θ/2).
+    io::Hdf5File f(tmp.file("s.h5"), io::Hdf5File::Mode::Read);
+    EXPECT_EQ(f.read_scalar("/meta/format_version"), 2.0);
+    EXPECT_EQ(f.shape("/frames/joints"), (std::vector<std::int64_t>{3, 48, 3}));
+    std::vector<std::int64_t> shape;
+    const std::vector<double> p = f.read_nd("/frames/object_poses", {}, &shape);
+    ASSERT_EQ(shape, (std::vector<std::int64_t>{3, 2, 7}));
+    const double expected[7] = {3.0, 0.2, -0.6, std::cos(0.45), 0, 0, std::sin(0.45)};
+    for (int k = 0; k < 7; ++k) EXPECT_NEAR(p[size_t((2 * 2 + 0) * 7 + k)], expected[k], 1e-15) << k;
+    EXPECT_EQ(f.read_strings("/bodies/names"), (std::vector<std::string>{"alice", "bob"}));
+  }
+  const SimulationResult b = read_simulation_result(tmp.file("s.h5"));
+  EXPECT_EQ(b.body_names, r.body_names);
+  EXPECT_EQ(b.body_vertex_offsets, r.body_vertex_offsets);
+  EXPECT_EQ(b.frame_joints[1], r.frame_joints[1]);
+  EXPECT_EQ(b.faces, r.faces);
+  EXPECT_EQ(b.newton_iters, 3);
+  EXPECT_EQ(b.rejected, 1);
+  ASSERT_EQ(b.objects.size(), 2u);
+  for (size_t o = 0; o < 2; ++o) {
+    const ObjectTrack &w = r.objects[o], &g = b.objects[o];
+    EXPECT_EQ(g.name, w.name);
+    EXPECT_EQ(g.shape, w.shape);
+    EXPECT_EQ(g.kind, w.kind);
+    EXPECT_EQ(g.vertices, w.vertices);
+    EXPECT_EQ(g.faces, w.faces);
+    ASSERT_EQ(g.poses.size(), 3u);
+    for (size_t i = 0; i < 3; ++i) EXPECT_LT((g.poses[i].matrix() - w.poses[i].matrix()).norm(), 1e-14) << o << " " << i;
+  }
+  EXPECT_GT((b.objects[0].poses[1].matrix() - b.objects[1].poses[1].matrix()).norm(), 0.5);
+  const std::string d = describe_scene_parts(b);
+  EXPECT_NE(d.find("bodies: alice (3 skin vertices), bob (3 skin vertices)"), std::string::npos) << d;
+  EXPECT_NE(d.find("objects: ball (sphere, dynamic), crate (box, kinematic)"), std::string::npos) << d;
+  EXPECT_EQ(describe_scene_parts(small_result()), "");
+}
+
+TEST(ResultFile, WriterRejectsScenesThatDoNotFit) {
+  test::TempDir tmp;
+  SimulationResult r = scene_result();
+  r.body_vertex_offsets = {0, 4};
+  test::expect_error([&] { write_simulation_result(r, tmp.file("a.h5")); }, {"a.h5", "/bodies/vertex_offsets", "3 entries"});
+  r = scene_result();
+  r.objects[1].shape = "cone";
+  test::expect_error([&] { write_simulation_result(r, tmp.file("a.h5")); }, {"crate", "shape 'cone'"});
+  r = scene_result();
+  r.objects[0].poses[2].linear() *= 1.5;
+  test::expect_error([&] { write_simulation_result(r, tmp.file("a.h5")); }, {"frame 2", "'ball'", "rigid"});
+  r = scene_result();
+  r.objects[0].poses.pop_back();
+  test::expect_error([&] { write_simulation_result(r, tmp.file("a.h5")); }, {"'ball' has 2 poses for 3 frames"});
+  r = scene_result();
+  r.frame_joints[1] = Points::Zero(24, 3);
+  test::expect_error([&] { write_simulation_result(r, tmp.file("a.h5")); }, {"frame 1", "joints", "48"});
+  EXPECT_FALSE(std::filesystem::exists(tmp.file("a.h5")));
+  // Streaming: a frame without the object poses.
+  r = scene_result();
+  ResultWriter w(tmp.file("b.h5"), r.faces, r.surface_rest, 5, false, result_scene(r));
+  test::expect_error([&] { w.add_frame({0.0, 1.0, r.frame_positions[0], r.frame_displacement[0], r.frame_joints[0], r.frame_reduced[0], Vec3::Zero(), {}}); },
+                     {"frame 0", "0 object poses for 2 objects"});
+}
+
+namespace {
+
+/// A result file written dataset by dataset (not through ResultWriter), in
+/// the layout of format `version`, with knobs to break it.
+struct RawFile {
+  int version = 2;
+  std::vector<std::string> body_names;
+  std::vector<int> offsets;
+  std::int64_t joint_rows = 24;
+  int objects = 0;         ///< objects in /frames/object_poses
+  int object_groups = -1;  ///< /objects/<i> groups written (-1: = objects)
+  double quaternion_scale = 1.0;
+  int face_index = 2;      ///< the skin triangle's last index (3 vertices)
+};
+
+void write_raw(const std::string& path, const RawFile& o) {
+  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
+  f.write_scalar("/meta/format_version", std::int64_t(o.version));
+  f.write_string("/meta/units", "metres, seconds");
+  f.write_string("/meta/avatar", "old.h5");
+  f.write_string("/meta/motion", "builtin:walk");
+  f.write_scalar("/meta/dt", 0.01);
+  f.write_string("/meta/bones", "kinematic");
+  f.write_scalar("/meta/newton_iters", std::int64_t(2));
+  const int faces[3] = {0, 1, o.face_index};
+  f.write("/surface/faces", faces, 1, 3);
+  const double rest[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  f.write("/surface/rest", rest, 3, 3);
+  if (!o.body_names.empty()) f.write_strings("/bodies/names", o.body_names);
+  if (!o.offsets.empty()) f.write_nd("/bodies/vertex_offsets", o.offsets.data(), {std::int64_t(o.offsets.size())});
+  const double time[2] = {0.0, 0.5}, ms[2] = {1.5, 2.5};
+  f.write_nd("/frames/time", time, {2});
+  f.write_nd("/frames/step_ms", ms, {2});
+  std::vector<double> pos(18), joints(size_t(2 * o.joint_rows * 3)), reduced(8);
+  for (size_t i = 0; i < pos.size(); ++i) pos[i] = 0.125 * double(i);
+  for (size_t i = 0; i < joints.size(); ++i) joints[i] = -0.5 * double(i);
+  for (size_t i = 0; i < reduced.size(); ++i) reduced[i] = 0.25 * double(i);
+  f.write_nd("/frames/positions", pos.data(), {2, 3, 3}, true);
+  f.write_nd("/frames/displacement", pos.data(), {2, 3, 3}, true);
+  f.write_nd("/frames/joints", joints.data(), {2, o.joint_rows, 3});
+  f.write_nd("/frames/reduced", reduced.data(), {2, 4});
+  if (o.objects > 0) {
+    std::vector<double> poses;
+    for (int i = 0; i < 2 * o.objects; ++i)
+      for (double x : {0.1 * i, 1.0, 2.0, o.quaternion_scale * std::cos(0.2 * i), 0.0, o.quaternion_scale * std::sin(0.2 * i), 0.0})
+        poses.push_back(x);
+    f.write_nd("/frames/object_poses", poses.data(), {2, o.objects, 7});
+  }
+  const int groups = o.object_groups < 0 ? o.objects : o.object_groups;
+  for (int i = 0; i < groups; ++i) {
+    const std::string g = "/objects/" + std::to_string(i);
+    f.write_string(g + "/name", "obj" + std::to_string(i));
+    f.write_string(g + "/shape", "box");
+    f.write_string(g + "/kind", "static");
+    f.write(g + "/vertices", rest, 3, 3);
+    f.write(g + "/faces", faces, 1, 3);
+  }
+  const double steps[3] = {0.01, 0.02, 0.03}, outcome[3] = {0, 1, 0};
+  for (const char* n : {"/steps/time", "/steps/energy", "/steps/grad_norm", "/steps/newton_decrement", "/steps/ms"})
+    f.write_nd(n, steps, {3});
+  f.write_nd("/steps/outcome", outcome, {3});
+  f.commit();
+}
+
+}  // namespace
+
+TEST(ResultFile, VersionOneFilesStillRead) {
+  test::TempDir tmp;
+  RawFile v1;
+  v1.version = 1;
+  write_raw(tmp.file("v1.h5"), v1);
+  const SimulationResult r = read_simulation_result(tmp.file("v1.h5"));
+  EXPECT_EQ(r.avatar, "old.h5");
+  EXPECT_EQ(r.num_frames, 2);
+  EXPECT_TRUE(r.body_names.empty());
+  EXPECT_TRUE(r.objects.empty());
+  ASSERT_EQ(r.frame_joints.size(), 2u);
+  EXPECT_EQ(r.frame_joints[1].rows(), 24);
+  EXPECT_EQ(r.frame_joints[1](0, 0), -0.5 * 72);
+  EXPECT_EQ(r.frame_positions[1](2, 2), 0.125 * 17);
+  EXPECT_EQ(r.frame_reduced[1][3], 0.25 * 7);
+  EXPECT_EQ(r.damped, 1);
+  // The same layout with two objects and two bodies is a valid version 2 file.
+  RawFile v2;
+  v2.body_names = {"a", "b"};
+  v2.offsets = {0, 1, 3};
+  v2.joint_rows = 48;
+  v2.objects = 2;
+  write_raw(tmp.file("v2.h5"), v2);
+  const SimulationResult s = read_simulation_result(tmp.file("v2.h5"));
+  ASSERT_EQ(s.objects.size(), 2u);
+  EXPECT_EQ(s.objects[1].name, "obj1");
+  // Object 1 at frame 1 is row 3: q = (cos 0.6, 0, sin 0.6, 0), a turn by
+  // 1.2 rad about +Y, at (0.3, 1, 2).
+  const Isometry expected = pose(1.2, Vec3::UnitY(), Vec3(0.3, 1, 2));
+  EXPECT_LT((s.objects[1].poses[1].matrix() - expected.matrix()).norm(), 1e-14);
+}
+
+TEST(ResultFile, ReaderRejectsMalformedScenes) {
+  test::TempDir tmp;
+  auto expect_rejected = [&](const RawFile& o, std::initializer_list<std::string> fragments) {
+    write_raw(tmp.file("bad.h5"), o);
+    test::expect_error([&] { read_simulation_result(tmp.file("bad.h5")); }, fragments);
+  };
+  RawFile o;
+  o.version = 3;
+  expect_rejected(o, {"bad.h5", "/meta/format_version is 3"});
+  o = RawFile();
+  o.body_names = {"a", "b"};
+  o.offsets = {0, 3};
+  o.joint_rows = 48;
+  expect_rejected(o, {"bad.h5", "/bodies/names has 2 bodies", "3 entries, got 2"});
+  o.offsets = {0, 2, 3};
+  o.joint_rows = 24;
+  expect_rejected(o, {"bad.h5", "/frames/joints"});
+  o = RawFile();
+  o.offsets = {0, 3};
+  expect_rejected(o, {"/bodies/vertex_offsets given without /bodies/names"});
+  o = RawFile();
+  o.objects = 2;
+  o.quaternion_scale = 1.1;
+  expect_rejected(o, {"bad.h5", "/frames/object_poses, frame 0, object 0", "unit quaternion"});
+  o.quaternion_scale = 1.0;
+  o.object_groups = 1;
+  expect_rejected(o, {"bad.h5", "/objects/1 is missing"});
+  o.object_groups = 3;
+  expect_rejected(o, {"bad.h5", "/objects/2 has no poses"});
+  o = RawFile();
+  o.face_index = 3;
+  expect_rejected(o, {"bad.h5", "/surface/faces"});
 }

@@ -44,12 +44,25 @@ struct RenderOptions {
 Image render_views(const Points& V, const Triangles& F, const RenderOptions& options = {},
                    const Points& colors = Points());
 
+/// A surface drawn in one colour next to a strip frame's coloured surface
+/// (e.g. a rigid object of a scene in neutral grey).
+struct SolidSurface {
+  Points vertices;                    ///< #N by 3 (m, same space as the frame's vertices)
+  Triangles faces;                    ///< #M by 3
+  Vec3 color = Vec3(0.6, 0.6, 0.6);   ///< albedo, RGB in [0, 1] (default neutral grey)
+  /// Counts towards the strip's framing (within StripOptions::solid_margin);
+  /// false for unbounded things drawn as big patches, such as a floor.
+  bool frames_view = true;
+};
+
 /// One frame of a strip: the surface and a scalar per vertex (e.g. soft-tissue
 /// displacement magnitude in mm).
 struct StripFrame {
   Points vertices;    ///< #V by 3
   VecX values;        ///< #V
   std::string label;  ///< caption under the frame (e.g. "t=0.50 s"), may be empty
+  /// Drawn with the surface (z-buffered together), clipped to the frame's panel.
+  std::vector<SolidSurface> solids;
 };
 
 struct StripOptions {
@@ -63,12 +76,18 @@ struct StripOptions {
   std::string title;                 ///< optional line at the top
   int supersample = 2;
   Rgb8 background = {232, 232, 232};
+  /// How far solids (SolidSurface::frames_view) may widen the window beyond
+  /// the coloured surfaces' own, per side, as a fraction of that window's
+  /// larger side (default 0.5); what lies further out is clipped.
+  double solid_margin = 0.5;
 };
 
 /// Renders frames side by side with one shared world window (so motion shows
 /// as movement between panels) and a colour bar with min / max labels on the
-/// right. All frames share the faces F (#F by 3). Throws on an empty list or
-/// mismatched sizes.
+/// right. The window holds every frame's coloured surface and, within
+/// `solid_margin`, its solids; each panel clips what falls outside it. All
+/// frames share the faces F (#F by 3). Throws on an empty list or mismatched
+/// sizes.
 Image render_strip(const std::vector<StripFrame>& frames, const Triangles& F, const StripOptions& options = {});
 
 }  // namespace sflsh::io
