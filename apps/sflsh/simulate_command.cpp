@@ -16,12 +16,15 @@
 #include "sflsh/scene/material_file.hpp"
 #include "sflsh/scene/result_export.hpp"
 #include "sflsh/scene/result_file.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_run.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 
 namespace sflsh::cli {
 namespace {
 
 struct SimulateArgs {
+  std::string scene;  // a scene file (YAML); then the avatar/motion flags do not apply
   std::string avatar, motion = "builtin:jump", out = "result.h5", exp, render, material, dt = "1/60", bones = "dynamic";
   std::string units = "auto", joint_map, cache_dir, checkpoint, resume;
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
@@ -32,7 +35,37 @@ struct SimulateArgs {
 };
 
 
+/// `sflsh simulate scene.yaml`: the scene's outputs, overridden by --out/--export/--render when given.
+void run_scene_file(const SimulateArgs& a, bool out_given) {
+  SceneDescription scene = read_scene_description(a.scene);
+  validate_scene_files(scene);
+  if (out_given) scene.output.out = a.out;
+  if (!a.exp.empty()) scene.output.export_path = a.exp;
+  if (!a.render.empty()) scene.output.render = a.render;
+  const OutputDescription& out = scene.output;
+  io::check_output_file(out.out, "output.out");
+  if (!out.render.empty()) io::check_output_file(out.render, "output.render");
+  if (!out.export_path.empty()) io::check_output_file(out.export_path, "output.export");
+  SceneRunOptions o;
+  o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
+  SceneContactStats stats;
+  SimulationResult r;
+  {
+    const InterruptScope interrupt_scope;
+    r = run_scene(scene, o, &stats);
+    throw_if_interrupted("after the last step");
+  }
+  write_simulation_result(r, out.out);
+  std::cout << r.describe() << stats.describe() << "wrote " << out.out << " (" << r.num_frames << " frames)\n";
+  if (!out.export_path.empty()) std::cout << export_result(r, out.export_path) << "\n";
+  if (!out.render.empty()) {
+    render_result(r, out.render, out.render_frames);
+    std::cout << "wrote " << out.render << "\n";
+  }
+}
+
 void run_simulate(const SimulateArgs& a) {
+  require(!a.avatar.empty(), "simulate: give a scene file (sflsh simulate scene.yaml) or --avatar");
   RunOptions o;
   o.sim.h = parse_time_step(a.dt);
   require(a.bones == "dynamic" || a.bones == "kinematic", "--bones must be 'dynamic' or 'kinematic', got '", a.bones, "'");
@@ -126,8 +159,14 @@ void run_simulate(const SimulateArgs& a) {
 
 const CommandRegistrar reg(40, [](CLI::App& app) {
   auto a = std::make_shared<SimulateArgs>();
-  auto* cmd = app.add_subcommand("simulate", "Simulate an avatar driven by a motion (backward Euler, reduced soft tissue)");
-  cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute`")->required();
+  auto* cmd = app.add_subcommand(
+      "simulate",
+      "Simulate a scene file (bodies, rigid objects, contact; YAML) or one avatar driven by a motion (backward "
+      "Euler, reduced soft tissue)");
+  cmd->add_option("scene", a->scene,
+                  "Scene file (YAML; keys in include/sflsh/scene/scene_description.hpp, examples in apps/scenes/). "
+                  "--out/--export/--render override its outputs; the one-avatar flags do not apply");
+  cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute` (without a scene file)");
   cmd->add_option("--motion", a->motion, "builtin:jump|shake|idle, an AMASS .npz, a .bvh, or FBX/DAE/glTF")
       ->capture_default_str();
   cmd->add_option("--dt", a->dt, "Time step in seconds (e.g. 1/60)")->capture_default_str();
@@ -162,9 +201,16 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
-  cmd->callback([a, seconds] {
+  cmd->callback([a, seconds, cmd] {
     a->seconds_given = seconds->count() > 0;
-    run_simulate(*a);
+    if (!a->scene.empty()) {
+      for (const char* flag : {"--avatar", "--motion", "--dt", "--seconds", "--bones", "--newton-iters", "--material"})
+        require(cmd->count(flag) == 0, "simulate: ", flag, " does not apply to a scene file (", a->scene,
+                "); set it in the scene");
+      run_scene_file(*a, cmd->count("--out") > 0);
+    } else {
+      run_simulate(*a);
+    }
   });
 });
 

@@ -1,5 +1,7 @@
 #include "sflsh/scene/simulation_run.hpp"
 
+#include "sflsh/scene/result_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -65,6 +67,7 @@ std::string SimulationResult::describe() const {
   if (pelvis_frames > 0)
     o << std::setprecision(1) << "pelvis vs motion root: mean " << pelvis_error_mean * 1e3 << " mm, max "
       << pelvis_error_max * 1e3 << " mm over " << pelvis_frames << " frames\n";
+  o << describe_scene_parts(*this);
   return o.str();
 }
 

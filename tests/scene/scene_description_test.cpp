@@ -69,7 +69,7 @@ TEST(SceneDescription, ExampleScenesParse) {
   EXPECT_TRUE(walkers.collides("floor", "bob"));
   const SceneDescription press = read_scene_description(folder.file("box_press.yaml"));
   EXPECT_EQ(press.objects[0].keyframes.size(), 4u);
-  EXPECT_EQ(press.objects[0].position, Vec3(0, -0.1, 0.40));  // the first keyframe's
+  EXPECT_EQ(press.objects[0].position, Vec3(0, 1.05, 0.40));  // the first keyframe's
   EXPECT_TRUE(press.collides("press", "alice"));
 }
 

@@ -5,8 +5,9 @@
 // model and state.
 //
 // Top-level keys follow DESIGN.md §5b (bodies, objects, contact, solver,
-// output; `tools` is not read yet). Coordinates are the avatar's (SMPL) frame,
-// Y up: at rest the pelvis is near y = -0.22 m and the soles near y = -1.2 m.
+// output; `tools` is not read yet). Coordinates are the avatar's frame, Y up,
+// facing +Z: the built-in avatar stands on y = 0 (soles at y = -0.01 m, pelvis
+// at 0.94 m, belly front near z = 0.11 m at y = 1.05 m).
 //
 // Example (every key shown; defaults in the comments, "required" where there is none):
 //
@@ -26,9 +27,10 @@
 //     fps: 30                   # output frames per simulated second (> 0); default 30
 //   contact:
 //     stiffness:                # penalty ½k·d² per contact sample (N/m, >= 0)
-//       body_object: 2.0e4      # skin samples against rigid objects; default 2e4
-//       body_body: 1.0e4        # bone capsules of different bodies; default 1e4
-//       self: 5.0e3             # non-adjacent capsules of one body; default 5e3
+//       body_object: 2.0e5      # skin samples against rigid objects; default 2e5
+//                               # (an avatar dropped 0.4 m onto the floor: 4.2 mm deepest)
+//       body_body: 1.0e6        # bone capsules of different bodies; default 1e6
+//       self: 1.0e5             # non-adjacent capsules of one body; default 1e5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
 //     pairs: all                # default all: every body-object and body-body pair;
@@ -44,7 +46,8 @@
 //         heading_deg: 90       # rotation about +Y, degrees; default 0
 //       bones: dynamic          # dynamic | kinematic; default dynamic
 //       material: soft.yaml     # optional material file (relative to this file's folder)
-//       velocity: [0, 0, 0]     # m/s, initial linear velocity; default [0, 0, 0]
+//       velocity: [0, 0, 0]     # m/s, initial linear velocity; with a motion the placement
+//                               # also travels at it (a walk in place walks along it); default 0
 //   objects:                    # optional
 //     - name: floor             # required
 //       shape: {type: plane, normal: [0, 1, 0]}   # required; see below
@@ -101,7 +104,7 @@ struct BodyDescription {
   double heading_deg = 0;          ///< placement: rotation about +Y, degrees
   bool bones_dynamic = true;       ///< bones: dynamic (true) | kinematic
   std::string material;            ///< material override file (absolute), "" = none
-  Vec3 velocity = Vec3::Zero();    ///< m/s, initial linear velocity
+  Vec3 velocity = Vec3::Zero();    ///< m/s, initial linear velocity (with a motion: the placement's too)
 };
 
 enum class ShapeType { Plane, Sphere, Box, Capsule, Cylinder, Mesh };
@@ -151,9 +154,9 @@ struct RigidObjectDescription {
 };
 
 struct ContactDescription {
-  double body_object_stiffness = 2.0e4;  ///< N/m per skin sample
-  double body_body_stiffness = 1.0e4;    ///< N/m per capsule pair
-  double self_stiffness = 5.0e3;         ///< N/m per capsule pair of one body
+  double body_object_stiffness = 2.0e5;  ///< N/m per skin sample
+  double body_body_stiffness = 1.0e6;    ///< N/m per capsule pair
+  double self_stiffness = 1.0e5;         ///< N/m per capsule pair of one body
   bool self_contact = false;
   double sample_spacing = 0;             ///< m; 0 = every skin vertex
   /// true: every body–object and body–body pair collides; false: only `pairs`.

@@ -1,0 +1,37 @@
+#pragma once
+// A scene's rigid object made concrete (issue 10): its signed distance field
+// (exact for primitives, a baked grid for meshes), its surface for display,
+// its mass properties (dynamic objects) and its pose over time (kinematic
+// keyframes). Frames: the description's position/orientation place the
+// shape's own frame (primitive_sdfs.hpp); a dynamic object's body frame sits
+// at its centre of mass, shape_in_body = T(−centre).
+#include <string>
+
+#include "sflsh/geometry/mass_properties.hpp"
+#include "sflsh/geometry/primitive_meshes.hpp"
+#include "sflsh/geometry/sdf.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/sim/configuration.hpp"
+
+namespace sflsh {
+
+struct RigidObjectModel {
+  geometry::SdfPtr field;                 ///< in the shape frame
+  geometry::PrimitiveMesh surface;        ///< shape frame, for results (a plane: a 1 m patch)
+  geometry::MassProperties mass;          ///< dynamic objects only (density or mass)
+  Isometry shape_in_body = Isometry::Identity();  ///< T(−centre of mass)
+  std::string bake_report;                ///< mesh objects: what the SDF bake or cache did
+};
+
+/// Builds field, surface and (for dynamic objects) mass properties. Mesh
+/// objects are read (and checked closed) and baked, or loaded from
+/// `cache_dir` ("" = no cache). Errors name the object's location in the scene file.
+RigidObjectModel make_rigid_object(const RigidObjectDescription& object, const std::string& cache_dir);
+
+/// The shape frame's pose at time t (s): the fixed pose of static and dynamic
+/// objects (their initial one), or the keyframes of a kinematic object
+/// (positions linear, orientations slerped, held before the first and after
+/// the last keyframe).
+Isometry object_pose_at(const RigidObjectDescription& object, double t);
+
+}  // namespace sflsh

@@ -1,0 +1,107 @@
+#include "sflsh/scene/rigid_object.hpp"
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/geometry/grid_sdf.hpp"
+#include "sflsh/geometry/primitive_sdfs.hpp"
+#include "sflsh/io/mesh_export.hpp"
+#include "sflsh/meshing/mesh_sdf_bake.hpp"
+
+namespace sflsh {
+namespace {
+
+Isometry make_pose(const Vec3& p, const Eigen::Quaterniond& q) {
+  Isometry T = Isometry::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = p;
+  return T;
+}
+
+/// Mass properties of a primitive by density, or scaled to the given mass.
+template <class Shape>
+geometry::MassProperties mass_of(const Shape& shape, const RigidObjectDescription& o) {
+  if (o.density > 0) return geometry::mass_properties(shape, o.density);
+  return geometry::mass_properties(shape, 1.0).with_mass(o.mass);
+}
+
+}  // namespace
+
+RigidObjectModel make_rigid_object(const RigidObjectDescription& o, const std::string& cache_dir) {
+  RigidObjectModel m;
+  const ShapeDescription& s = o.shape;
+  const bool dynamic = o.kind == ObjectKind::Dynamic;
+  switch (s.type) {
+    case ShapeType::Plane: {
+      require(!dynamic, s.location, ": a plane cannot be dynamic");
+      m.field = std::make_shared<geometry::PlaneSdf>(s.normal, 0.0);
+      m.surface = geometry::plane_patch_mesh(s.normal, 0.0, 0.5);
+      break;
+    }
+    case ShapeType::Sphere: {
+      auto f = std::make_shared<geometry::SphereSdf>(s.radius);
+      m.surface = geometry::primitive_mesh(*f);
+      if (dynamic) m.mass = mass_of(*f, o);
+      m.field = f;
+      break;
+    }
+    case ShapeType::Box: {
+      auto f = std::make_shared<geometry::BoxSdf>(0.5 * s.size);
+      m.surface = geometry::primitive_mesh(*f);
+      if (dynamic) m.mass = mass_of(*f, o);
+      m.field = f;
+      break;
+    }
+    case ShapeType::Capsule: {
+      auto f = std::make_shared<geometry::CapsuleSdf>(s.radius, 0.5 * s.length);
+      m.surface = geometry::primitive_mesh(*f);
+      if (dynamic) m.mass = mass_of(*f, o);
+      m.field = f;
+      break;
+    }
+    case ShapeType::Cylinder: {
+      auto f = std::make_shared<geometry::CylinderSdf>(s.radius, 0.5 * s.length);
+      m.surface = geometry::primitive_mesh(*f);
+      if (dynamic) m.mass = mass_of(*f, o);
+      m.field = f;
+      break;
+    }
+    case ShapeType::Mesh: {
+      try {
+        const io::ImportedMesh mesh = io::read_mesh(s.mesh_file);
+        m.surface.vertices = mesh.vertices * s.mesh_scale;
+        m.surface.faces = mesh.faces;
+        require_closed_mesh(m.surface.vertices, m.surface.faces, s.mesh_file);
+        MeshSdfBakeOptions bo;
+        bo.voxel_size = s.voxel_size;
+        bo.padding = s.padding;
+        bo.band = s.band;
+        MeshSdfBakeReport rep;
+        m.field = std::make_shared<geometry::GridSdf>(
+            load_or_bake_mesh_sdf(s.mesh_file, s.mesh_scale, bo, cache_dir, &rep));
+        m.bake_report = rep.describe();
+        if (dynamic)
+          m.mass = o.density > 0
+                       ? geometry::mesh_mass_properties(m.surface.vertices, m.surface.faces, o.density)
+                       : geometry::mesh_mass_properties(m.surface.vertices, m.surface.faces, 1.0).with_mass(o.mass);
+      } catch (const Error& e) {
+        fail(s.location, ": ", e.what());
+      }
+      break;
+    }
+  }
+  if (dynamic) m.shape_in_body.translation() = -m.mass.center;
+  return m;
+}
+
+Isometry object_pose_at(const RigidObjectDescription& o, double t) {
+  if (o.kind != ObjectKind::Kinematic || o.keyframes.empty()) return make_pose(o.position, o.orientation);
+  const std::vector<Keyframe>& k = o.keyframes;
+  if (t <= k.front().time) return make_pose(k.front().position, k.front().orientation);
+  if (t >= k.back().time) return make_pose(k.back().position, k.back().orientation);
+  size_t i = 1;
+  while (k[i].time < t) ++i;
+  const double a = (t - k[i - 1].time) / (k[i].time - k[i - 1].time);
+  return make_pose((1 - a) * k[i - 1].position + a * k[i].position,
+                   k[i - 1].orientation.normalized().slerp(a, k[i].orientation.normalized()));
+}
+
+}  // namespace sflsh

@@ -1,0 +1,363 @@
+#include "sflsh/scene/scene_run.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/interrupt.hpp"
+#include "sflsh/core/progress.hpp"
+#include "sflsh/core/rotation.hpp"
+#include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/material_file.hpp"
+#include "sflsh/scene/result_file.hpp"
+#include "sflsh/scene/rigid_object.hpp"
+#include "sflsh/sim/avatar_model.hpp"
+#include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/sim/momentum.hpp"
+#include "sflsh/sim/rigid_body_terms.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/skeleton_terms.hpp"
+#include "sflsh/sim/soft_tissue_terms.hpp"
+
+namespace sflsh {
+namespace {
+
+/// A body of the scene as the run drives it.
+struct SceneBody {
+  const BodyDescription* desc = nullptr;
+  std::shared_ptr<const Avatar> avatar;
+  bool has_motion = false;
+  MotionClip motion;
+  int model_index = 0;
+  Isometry placement = Isometry::Identity();  ///< at t = 0
+};
+
+struct SceneObject {
+  const RigidObjectDescription* desc = nullptr;
+  RigidObjectModel model;
+  int model_index = -1;  ///< dynamic objects: their body in the model
+};
+
+/// The placement at time t: heading about +Y, offset, travelling at the body's velocity.
+Isometry placement_at(const SceneBody& b, double t) {
+  Isometry P = b.placement;
+  if (b.has_motion) P.translation() += b.desc->velocity * t;
+  return P;
+}
+
+/// The motion's pose at t (the rest pose without a motion), placed by P.
+BodyPose placed_pose(const SceneBody& b, double t) {
+  BodyPose pose = b.has_motion ? b.motion.sample(t) : BodyPose{};
+  const Isometry P = placement_at(b, t);
+  const Vec3 root = b.avatar->joints_rest.row(0).transpose();
+  pose.axis_angle.row(0) = rotation_log(P.linear() * rodrigues(pose.axis_angle.row(0).transpose())).transpose();
+  pose.translation = P * (root + pose.translation) - root;
+  return pose;
+}
+
+std::string motion_spec_name(const std::string& spec) {
+  const size_t slash = spec.find_last_of('/');
+  return slash == std::string::npos ? spec : spec.substr(slash + 1);
+}
+
+/// Where body `b` starts: the placed motion at t = 0, moving with the motion
+/// (and the body's velocity) over the first step.
+BodyState initial_state(const SceneBody& b, double h) {
+  BodyState s;
+  s.q.bones = target_bones(*b.avatar, placed_pose(b, 0.0));
+  s.q.z = VecX::Zero(b.avatar->num_reduced());
+  s.q_prev.z = s.q.z;
+  const std::vector<Isometry> next = target_bones(*b.avatar, placed_pose(b, h));
+  for (size_t j = 0; j < s.q.bones.size(); ++j) {
+    Isometry prev = b.has_motion ? Isometry(s.q.bones[j] * next[j].inverse() * s.q.bones[j]) : s.q.bones[j];
+    if (!b.has_motion) prev.translation() -= b.desc->velocity * h;
+    s.q_prev.bones.push_back(prev);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string SceneContactStats::describe() const {
+  std::ostringstream o;
+  o << std::fixed;
+  for (const Pair& p : pairs)
+    o << "contact " << p.term << " on " << p.body << ": max penetration " << std::setprecision(2)
+      << p.max_penetration * 1e3 << " mm, max force " << std::setprecision(1) << p.max_force << " N, in contact "
+      << p.active_steps << " steps\n";
+  const double p0 = momentum_start.norm();
+  o << std::setprecision(4) << "linear momentum: start " << p0 << " kg m/s, end " << momentum_end.norm()
+    << " kg m/s (change " << std::scientific << std::setprecision(2) << (momentum_end - momentum_start).norm()
+    << ")\n";
+  return o.str();
+}
+
+SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& opt, SceneContactStats* stats) {
+  require(!sc.bodies.empty(), sc.path, ": the scene has no bodies");
+  const double h = sc.solver.dt;
+
+  // Bodies: avatars (read once per file and material), motions, placement.
+  std::map<std::string, std::shared_ptr<const Avatar>> avatars;
+  std::vector<SceneBody> bodies(sc.bodies.size());
+  double seconds = sc.solver.seconds;
+  for (size_t i = 0; i < sc.bodies.size(); ++i) {
+    const BodyDescription& d = sc.bodies[i];
+    SceneBody& b = bodies[i];
+    b.desc = &d;
+    const std::string key = d.avatar + "\n" + d.material;
+    auto it = avatars.find(key);
+    if (it == avatars.end()) {
+      auto a = std::make_shared<Avatar>(read_avatar(d.avatar));
+      if (!d.material.empty()) apply_material_file(d.material, a->materials);
+      it = avatars.emplace(key, std::move(a)).first;
+    }
+    b.avatar = it->second;
+    b.placement.linear() = Eigen::AngleAxisd(d.heading_deg * M_PI / 180.0, Vec3::UnitY()).toRotationMatrix();
+    b.placement.translation() = d.offset;
+    if (d.motion != "none") {
+      MotionOptions mo;
+      mo.rest_joints = b.avatar->joints_rest;
+      mo.builtin_seconds = seconds > 0 ? seconds : 5.0;
+      try {
+        b.motion = load_motion(d.motion, mo);
+      } catch (const Error& e) {
+        fail(sc.path, ": bodies '", d.name, "': motion ", d.motion, ": ", e.what());
+      }
+      b.has_motion = true;
+      if (sc.solver.seconds == 0) seconds = std::max(seconds, b.motion.duration());
+    }
+  }
+  require(seconds > 0, sc.path, ": solver.seconds is 0 and no body has a motion; give solver.seconds");
+  const long steps = std::max(1L, long(std::llround(seconds / h)));
+
+  // The model.
+  ModelOptions mo;
+  mo.h = h;
+  mo.gravity = sc.solver.gravity;
+  mo.newton.iterations = sc.solver.newton_iterations;
+  mo.newton.line_search = sc.solver.line_search;
+  ModelBuilder mb(mo);
+  auto in_body_contact = [&](const BodyDescription& d) {
+    for (const BodyDescription& other : sc.bodies)
+      if (&other != &d && sc.collides(d.name, other.name)) return true;
+    return false;
+  };
+  for (SceneBody& b : bodies) {
+    b.model_index = mb.add_body({b.desc->name, b.avatar, b.desc->bones_dynamic});
+    add_soft_tissue_terms(mb, b.model_index, {true, sc.solver.damping});
+    if (b.desc->bones_dynamic) {
+      SkeletonTermsOptions sk;
+      sk.track_root = b.has_motion;
+      if (in_body_contact(*b.desc))
+        sk.root_force_limit = opt.body_push_limit * estimate_body_mass(*b.avatar) * mo.gravity.norm();
+      add_skeleton_terms(mb, b.model_index, sk);
+    }
+  }
+  std::vector<SceneObject> objects(sc.objects.size());
+  for (size_t i = 0; i < sc.objects.size(); ++i) {
+    SceneObject& o = objects[i];
+    o.desc = &sc.objects[i];
+    o.model = make_rigid_object(*o.desc, opt.cache_dir);
+    if (!o.model.bake_report.empty() && opt.progress) std::cerr << o.desc->name << ": " << o.model.bake_report << "\n";
+    if (o.desc->kind == ObjectKind::Dynamic) {
+      o.model_index = mb.add_body({o.desc->name, nullptr, true});
+      add_rigid_body_terms(mb, o.model_index, o.model.mass.mass, o.model.mass.inertia);
+    }
+  }
+  // Contact terms: only the pairs the scene asks for.
+  const ContactDescription& c = sc.contact;
+  std::map<const Avatar*, std::shared_ptr<const PosedPoints>> samples;
+  for (const SceneBody& b : bodies) {
+    for (const SceneObject& o : objects) {
+      if (!sc.collides(b.desc->name, o.desc->name)) continue;
+      auto& pts = samples[b.avatar.get()];
+      if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
+      SdfContactOptions co;
+      co.stiffness = c.body_object_stiffness;
+      const bool dynamic = o.model_index >= 0;
+      auto term = std::make_shared<const SdfContactTerm>(o.desc->name, *pts, o.model.field,
+                                                         dynamic ? o.model.shape_in_body : Isometry::Identity(),
+                                                         dynamic, co);
+      if (dynamic) {
+        mb.add_term(term, {b.model_index, o.model_index});
+      } else {
+        mb.add_term(term, {b.model_index});
+      }
+    }
+  }
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const SceneBody& a = bodies[i];
+    for (size_t j = i + 1; j < bodies.size(); ++j) {
+      const SceneBody& b = bodies[j];
+      if (!sc.collides(a.desc->name, b.desc->name)) continue;
+      if (!a.desc->bones_dynamic && !b.desc->bones_dynamic) continue;  // nothing can move
+      require(!a.avatar->capsules.empty() && !b.avatar->capsules.empty(), sc.path, ": bodies '", a.desc->name,
+              "' and '", b.desc->name, "' collide, but an avatar has no bone capsules (/skeleton/capsules)");
+      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, b.avatar.get(),
+                                                             CapsuleContactOptions{c.body_body_stiffness, 2}),
+                  {a.model_index, b.model_index});
+    }
+    if (c.self_contact && a.desc->bones_dynamic && !a.avatar->capsules.empty())
+      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, nullptr,
+                                                             CapsuleContactOptions{c.self_stiffness, 2}),
+                  {a.model_index});
+  }
+  Simulator sim(mb.build());
+
+  // Initial state.
+  State s = sim.scene_state();
+  for (const SceneBody& b : bodies) s.bodies[b.model_index] = initial_state(b, h);
+  for (const SceneObject& o : objects) {
+    if (o.model_index < 0) continue;
+    const Isometry G = object_pose_at(*o.desc, 0.0) * o.model.shape_in_body.inverse();
+    Isometry G_prev = G;
+    G_prev.translation() -= o.desc->velocity * h;
+    const double w = o.desc->angular_velocity.norm();
+    if (w > 0)
+      G_prev.linear() = Eigen::AngleAxisd(-w * h, o.desc->angular_velocity / w).toRotationMatrix() * G.linear();
+    s.bodies[o.model_index] = {Configuration{{G}, VecX(0)}, Configuration{{G_prev}, VecX(0)}};
+  }
+  sim.set_state(s);
+
+  // Result skeleton: every body's skin concatenated, the objects' surfaces.
+  SimulationResult r;
+  r.motion = sc.path.empty() ? std::string("scene") : motion_spec_name(sc.path);
+  r.dt = h;
+  r.bones_dynamic = bodies[0].desc->bones_dynamic;
+  r.newton_iters = sc.solver.newton_iterations;
+  r.body_vertex_offsets.push_back(0);
+  {
+    std::string names;
+    int V = 0, F = 0;
+    for (const SceneBody& b : bodies) {
+      V += int(b.avatar->surface_rest.rows());
+      F += int(b.avatar->surface_faces.rows());
+    }
+    r.surface_rest.resize(V, 3);
+    r.faces.resize(F, 3);
+    V = F = 0;
+    for (const SceneBody& b : bodies) {
+      r.surface_rest.middleRows(V, b.avatar->surface_rest.rows()) = b.avatar->surface_rest;
+      r.faces.middleRows(F, b.avatar->surface_faces.rows()) = b.avatar->surface_faces.array() + V;
+      V += int(b.avatar->surface_rest.rows());
+      F += int(b.avatar->surface_faces.rows());
+      r.body_names.push_back(b.desc->name);
+      r.body_vertex_offsets.push_back(V);
+      names += (names.empty() ? "" : ", ") + b.desc->name + " (" + motion_spec_name(b.desc->avatar) + ")";
+    }
+    r.avatar = names;
+  }
+  for (const SceneObject& o : objects)
+    r.objects.push_back({o.desc->name, shape_type_name(o.desc->shape.type), object_kind_name(o.desc->kind),
+                         o.model.surface.vertices, o.model.surface.faces, {}});
+
+  auto object_pose = [&](const SceneObject& o, double t) {
+    if (o.model_index < 0) return object_pose_at(*o.desc, t);
+    return Isometry(sim.state(o.model_index).bones[0] * o.model.shape_in_body);
+  };
+  auto record_frame = [&](double t, double ms) {
+    const int V = r.body_vertex_offsets.back();
+    Points positions(V, 3), displacement(V, 3), joints(24 * int(bodies.size()), 3);
+    VecX reduced(0);
+    for (size_t i = 0; i < bodies.size(); ++i) {
+      const int v0 = r.body_vertex_offsets[i], n = r.body_vertex_offsets[i + 1] - v0, k = bodies[i].model_index;
+      positions.middleRows(v0, n) = sim.posed_surface(k);
+      displacement.middleRows(v0, n) = sim.soft_displacement(k);
+      joints.middleRows(24 * int(i), 24) = sim.joints(k);
+      const VecX& z = sim.state(k).z;
+      VecX grown(reduced.size() + z.size());
+      grown << reduced, z;
+      reduced = std::move(grown);
+    }
+    const SceneBody& b0 = bodies[0];
+    r.frame_time.push_back(t);
+    r.frame_step_ms.push_back(ms);
+    r.frame_positions.push_back(std::move(positions));
+    r.frame_displacement.push_back(std::move(displacement));
+    r.frame_joints.push_back(std::move(joints));
+    r.frame_reduced.push_back(std::move(reduced));
+    r.frame_target_pelvis.push_back(placed_pose(b0, t).translation + b0.avatar->joints_rest.row(0).transpose());
+    for (size_t i = 0; i < objects.size(); ++i) r.objects[i].poses.push_back(object_pose(objects[i], t));
+    ++r.num_frames;
+  };
+  record_frame(0.0, 0.0);
+
+  SceneContactStats st;
+  st.momentum_start = linear_momentum(sim.model(), sim.scene_state());
+  std::map<std::pair<std::string, int>, size_t> pair_index;
+  const double frame_dt = 1.0 / sc.output.fps;
+  double next_frame = frame_dt, ms_since_frame = 0;
+  int steps_since_frame = 0;
+  StepInputs in;
+  in.bodies.resize(sim.model().bodies().size());
+  Progress progress("simulating " + r.motion, steps);
+  for (long k = 0; k < steps; ++k) {
+    if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
+    const double t = (k + 1) * h;
+    for (const SceneBody& b : bodies) {
+      BodyTargets& bt = in.bodies[b.model_index];
+      bt.pose = placed_pose(b, t);
+      bt.bones = target_bones(*b.avatar, bt.pose);
+    }
+    for (const SceneObject& o : objects) {
+      if (o.model_index >= 0) continue;
+      WorldFrame& f = in.frames[o.desc->name];
+      f.pose = object_pose_at(*o.desc, t);
+      const Isometry before = object_pose_at(*o.desc, t - h);
+      f.linear_velocity = (f.pose.translation() - before.translation()) / h;
+      f.angular_velocity = rotation_log(f.pose.linear() * before.linear().transpose()) / h;
+    }
+    const StepReport rep = sim.step(in);
+    for (const SceneBody& b : bodies)
+      if (!sim.state(b.model_index).z.allFinite() || !sim.state(b.model_index).bones[0].matrix().allFinite())
+        fail(sc.path, ": body '", b.desc->name, "' became non-finite at step ", k + 1, " (t = ", t,
+             " s); try a smaller solver.dt or lower contact stiffness");
+    for (const SceneObject& o : objects)
+      if (o.model_index >= 0 && !sim.state(o.model_index).bones[0].matrix().allFinite())
+        fail(sc.path, ": object '", o.desc->name, "' became non-finite at step ", k + 1, " (t = ", t, " s)");
+    // Contact figures from the terms' reports.
+    for (const TermQuantityReport& q : rep.quantities) {
+      const auto key = std::make_pair(q.term, q.body);
+      auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
+      if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});
+      SceneContactStats::Pair& p = st.pairs[it->second];
+      if (q.name == "max_penetration" || q.name == "max_overlap") {
+        p.max_penetration = std::max(p.max_penetration, q.value[0]);
+        if (q.value[0] > 0) ++p.active_steps;
+      } else if (q.name == "force" && q.value.size() == 3) {
+        p.last_force = Vec3(q.value[0], q.value[1], q.value[2]);
+        p.max_force = std::max(p.max_force, p.last_force.norm());
+      }
+    }
+    r.step_time.push_back(t);
+    r.step_energy.push_back(rep.energy_after);
+    r.step_grad_norm.push_back(rep.grad_norm_before);
+    r.step_decrement.push_back(rep.newton_decrement);
+    r.step_outcome.push_back(int(rep.outcome));
+    r.step_ms.push_back(rep.ms_total);
+    r.add_step_times(rep);
+    r.accepted += rep.accepted;
+    r.damped += rep.damped;
+    r.rejected += rep.rejected;
+    ms_since_frame += rep.ms_total;
+    ++steps_since_frame;
+    if (t + 1e-9 >= next_frame) {
+      record_frame(t, ms_since_frame / steps_since_frame);
+      next_frame += frame_dt;
+      ms_since_frame = 0;
+      steps_since_frame = 0;
+    }
+    if (opt.progress) progress.update(k + 1);
+  }
+  if (opt.progress) progress.finish();
+  st.momentum_end = linear_momentum(sim.model(), sim.scene_state());
+  if (stats) *stats = std::move(st);
+  return r;
+}
+
+}  // namespace sflsh

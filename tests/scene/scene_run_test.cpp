@@ -1,0 +1,168 @@
+// Running scene files (issue 10) on a small synthetic avatar written to a
+// temporary folder: a dynamic ball in free fall follows backward Euler's
+// closed form until it lands and then rests on the body, a kinematic object's
+// poses are its keyframes, several bodies are concatenated in the result, and
+// the CLI runs a scene file and refuses the one-avatar flags with it.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/scene/result_file.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_run.hpp"
+#include "sim/skeleton_fixture.hpp"
+#include "sim/synthetic_avatar.hpp"
+#include "test_support.hpp"
+
+using namespace sflsh;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A folder with a small avatar file (6 cm box of 1 cm cells, top at y = 0.03 m).
+class SceneRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("sflsh_scene_run_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    test::SyntheticAvatarOptions o;
+    o.nx = o.nz = 6;
+    o.cell = 0.01;
+    o.handles = 6;
+    o.handle_radius = 0.1;
+    o.all_tets = false;
+    o.samples = 10;
+    Avatar a = test::make_synthetic_avatar(o);
+    a.joints_rest = test::make_tpose_skeleton().joints_rest;
+    a.capsules = {{3, Vec3(0, 0.005, 0), Vec3(0, 0.025, 0), 0.025}};
+    write_avatar(a, (dir_ / "box.h5").string());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write_scene(const std::string& text) {
+    const std::string p = (dir_ / "scene.yaml").string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path dir_;
+};
+
+TEST_F(SceneRun, ABallFallsFreelyAnotherRestsOnTheBody) {
+  // "drop", far from the body, falls freely: backward Euler from rest gives
+  // v_n = −g h n, y_n = y_0 − g h² n(n+1)/2. "ball" starts 3 mm above the top.
+  const double h = 1.0 / 60, g = 9.81, y0 = 0.20, r = 0.05;
+  SceneDescription sc = read_scene_description(write_scene(R"(
+solver: {dt: 1/60, seconds: 1.5, newton_iters: 4, line_search: true}
+output: {fps: 60}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - name: ball
+    shape: {type: sphere, radius: 0.05}
+    kind: dynamic
+    mass: 0.2
+    position: [0.0, 0.083, 0.0]
+  - name: drop
+    shape: {type: box, size: [0.1, 0.05, 0.02]}
+    kind: dynamic
+    density: 700
+    position: [2.0, 0.20, 0]
+)"));
+  SceneContactStats stats;
+  SceneRunOptions opt;
+  opt.progress = false;
+  const SimulationResult res = run_scene(sc, opt, &stats);
+  ASSERT_EQ(res.objects.size(), 2u);
+  const ObjectTrack &ball = res.objects[0], &drop = res.objects[1];
+  EXPECT_EQ(ball.shape, "sphere");
+  EXPECT_EQ(drop.shape, "box");
+  EXPECT_EQ(ball.kind, "dynamic");
+  ASSERT_EQ(drop.poses.size(), res.frame_time.size());
+  for (size_t f = 0; f < drop.poses.size(); ++f) {
+    const int n = int(std::lround(res.frame_time[f] / h));
+    EXPECT_NEAR(drop.poses[f].translation().y(), y0 - g * h * h * n * (n + 1) / 2, 1e-9) << "frame " << f;
+    EXPECT_NEAR(drop.poses[f].translation().x(), 2.0, 1e-12);
+    EXPECT_LT((drop.poses[f].linear() - Mat3::Identity()).norm(), 1e-12);
+  }
+  // At the end it rests on the top, held by its weight.
+  const Vec3 end = ball.poses.back().translation();
+  EXPECT_NEAR(end.y(), 0.03 + r, 0.01);
+  ASSERT_FALSE(stats.pairs.empty());
+  EXPECT_EQ(stats.pairs[0].term, "contact:ball");
+  EXPECT_NEAR(stats.pairs[0].last_force.y(), -0.2 * g, 0.02 * 0.2 * g);
+}
+
+TEST_F(SceneRun, KinematicObjectsFollowTheirKeyframesAndBodiesAreConcatenated) {
+  SceneDescription sc = read_scene_description(write_scene(R"(
+solver: {dt: 1/60, seconds: 1.0, gravity: [0, 0, 0]}
+output: {fps: 10}
+bodies:
+  - {name: left, avatar: box.h5, bones: kinematic, placement: {offset: [-0.5, 0, 0]}}
+  - {name: right, avatar: box.h5, bones: kinematic, placement: {offset: [0.5, 0, 0], heading_deg: 90}}
+objects:
+  - name: lid
+    shape: {type: box, size: [0.1, 0.02, 0.1]}
+    kind: kinematic
+    keyframes:
+      - {time: 0.0, position: [-0.5, 0.2, 0]}
+      - {time: 1.0, position: [-0.5, 0.1, 0], orientation: [0.7071067811865476, 0, 0.7071067811865476, 0]}
+)"));
+  SceneRunOptions opt;
+  opt.progress = false;
+  const SimulationResult res = run_scene(sc, opt);
+  ASSERT_EQ(res.body_names, (std::vector<std::string>{"left", "right"}));
+  const Avatar a = read_avatar((dir_ / "box.h5").string());
+  const int V = int(a.surface_rest.rows());
+  ASSERT_EQ(res.body_vertex_offsets, (std::vector<int>{0, V, 2 * V}));
+  ASSERT_EQ(res.faces.rows(), 2 * a.surface_faces.rows());
+  EXPECT_EQ(res.faces.bottomRows(a.surface_faces.rows()).minCoeff(), V);
+  // Placement: the right body's skin is the rest skin turned 90° about +Y and moved by +0.5 m in x.
+  const Points& x = res.frame_positions.back();
+  for (int v = 0; v < V; v += 7) {
+    const Vec3 p = a.surface_rest.row(v).transpose();
+    EXPECT_LT((x.row(V + v).transpose() - (Vec3(p.z(), p.y(), -p.x()) + Vec3(0.5, 0, 0))).norm(), 1e-9);
+    EXPECT_LT((x.row(v).transpose() - (p + Vec3(-0.5, 0, 0))).norm(), 1e-9);
+  }
+  ASSERT_EQ(res.frame_joints.back().rows(), 48);
+  // The lid at t = 0.5 s: halfway down, turned 45° about +Y (slerp).
+  const ObjectTrack& lid = res.objects[0];
+  size_t f = 0;
+  while (std::abs(res.frame_time[f] - 0.5) > 1e-9) ++f;
+  EXPECT_LT((lid.poses[f].translation() - Vec3(-0.5, 0.15, 0)).norm(), 1e-12);
+  EXPECT_LT((lid.poses[f].linear() - Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()).toRotationMatrix()).norm(), 1e-12);
+  // Kinematic bodies and a kinematic lid above them: no contact terms act, nothing moves softly.
+  EXPECT_LT(res.frame_displacement.back().cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST_F(SceneRun, CliRunsASceneFileAndRefusesOneAvatarFlagsWithIt) {
+  const std::string scene = write_scene(R"(
+solver: {dt: 1/60, seconds: 0.2}
+output: {out: out.h5, fps: 30}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - {name: ball, shape: {type: sphere, radius: 0.05}, kind: dynamic, density: 500, position: [0, 0.2, 0]}
+)");
+  const std::string out = (dir_ / "cli.h5").string();
+  std::string log;
+  ASSERT_EQ(test::run_command(test::sflsh_binary() + " simulate " + scene + " --out " + out, &log), 0) << log;
+  const SimulationResult r = read_simulation_result(out);
+  ASSERT_EQ(r.objects.size(), 1u);
+  EXPECT_EQ(r.objects[0].name, "ball");
+  EXPECT_NE(log.find("contact"), std::string::npos);
+  // A one-avatar flag with a scene file: one error line, non-zero exit, no output.
+  const std::string out2 = (dir_ / "cli2.h5").string();
+  EXPECT_NE(test::run_command(test::sflsh_binary() + " simulate " + scene + " --avatar x.h5 --out " + out2, &log), 0);
+  EXPECT_NE(log.find("--avatar does not apply to a scene file"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out2));
+  // A scene naming a missing avatar: file, line and key path.
+  const std::string bad = write_scene("bodies:\n  - {name: a, avatar: nowhere.h5}\nsolver: {seconds: 0.1}\n");
+  EXPECT_NE(test::run_command(test::sflsh_binary() + " simulate " + bad + " --out " + out2, &log), 0);
+  EXPECT_NE(log.find("scene.yaml:2: bodies[0].avatar"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out2));
+}
+
+}  // namespace
