@@ -301,7 +301,7 @@ RigidObjectDescription parse_object(const SceneParser& p, const YAML::Node& n, c
 
 ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, const SceneDescription& scene) {
   const std::string key = "contact";
-  p.check_map(n, key, {"stiffness", "self_contact", "sample_spacing", "pairs"}, "the contact settings");
+  p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs"}, "the contact settings");
   ContactDescription c;
   if (const auto s = n["stiffness"]) {
     const std::string sk = "contact.stiffness";
@@ -310,6 +310,7 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
     if (const auto v = s["body_body"]) c.body_body_stiffness = p.non_negative(v, sk + ".body_body");
     if (const auto v = s["self"]) c.self_stiffness = p.non_negative(v, sk + ".self");
   }
+  if (const auto v = n["friction"]) c.friction = p.non_negative(v, "contact.friction");
   if (const auto v = n["self_contact"]) c.self_contact = p.boolean(v, "contact.self_contact");
   if (const auto v = n["sample_spacing"]) c.sample_spacing = p.non_negative(v, "contact.sample_spacing");
   if (const auto v = n["pairs"]) {
@@ -562,7 +563,8 @@ std::string scene_description_yaml(const SceneDescription& scene) {
   e << YAML::Key << "contact" << YAML::Value << YAML::BeginMap << YAML::Key << "stiffness" << YAML::Value
     << YAML::BeginMap << YAML::Key << "body_object" << YAML::Value << num(c.body_object_stiffness) << YAML::Key
     << "body_body" << YAML::Value << num(c.body_body_stiffness) << YAML::Key << "self" << YAML::Value << num(c.self_stiffness)
-    << YAML::EndMap << YAML::Key << "self_contact" << YAML::Value << c.self_contact << YAML::Key << "sample_spacing"
+    << YAML::EndMap << YAML::Key << "friction" << YAML::Value << num(c.friction) << YAML::Key << "self_contact"
+    << YAML::Value << c.self_contact << YAML::Key << "sample_spacing"
     << YAML::Value << num(c.sample_spacing) << YAML::Key << "pairs" << YAML::Value;
   if (c.all_pairs) {
     e << "all";

@@ -89,7 +89,7 @@ std::string SceneContactStats::describe() const {
   for (const Pair& p : pairs)
     o << "contact " << p.term << " on " << p.body << ": max penetration " << std::setprecision(2)
       << p.max_penetration * 1e3 << " mm, max force " << std::setprecision(1) << p.max_force << " N, in contact "
-      << p.active_steps << " steps\n";
+      << p.active_steps << " steps; at the end " << p.last_force.transpose() << " N\n";
   const double p0 = momentum_start.norm();
   o << std::setprecision(4) << "linear momentum: start " << p0 << " kg m/s, end " << momentum_end.norm()
     << " kg m/s (change " << std::scientific << std::setprecision(2) << (momentum_end - momentum_start).norm()
@@ -179,6 +179,7 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
       if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
       SdfContactOptions co;
       co.stiffness = c.body_object_stiffness;
+      co.friction = c.friction;
       const bool dynamic = o.model_index >= 0;
       auto term = std::make_shared<const SdfContactTerm>(o.desc->name, *pts, o.model.field,
                                                          dynamic ? o.model.shape_in_body : Isometry::Identity(),

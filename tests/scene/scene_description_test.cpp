@@ -322,6 +322,7 @@ SceneDescription full_scene(const SceneFolder& folder) {
   s.objects = {floor, ball, crate, bar, post, chair};
 
   s.contact.body_object_stiffness = 3.5e4;
+  s.contact.friction = 0.35;
   s.contact.body_body_stiffness = 7.5e3;
   s.contact.self_stiffness = 1.25e3;
   s.contact.self_contact = true;
@@ -420,6 +421,7 @@ TEST(SceneDescription, FullRoundTripKeepsEveryField) {
   ASSERT_EQ(b.objects.size(), a.objects.size());
   for (std::size_t i = 0; i < a.objects.size(); ++i) expect_same_non_default(a.objects[i], b.objects[i]);
   EXPECT_FIELD(contact.body_object_stiffness);
+  EXPECT_FIELD(contact.friction);
   EXPECT_FIELD(contact.body_body_stiffness);
   EXPECT_FIELD(contact.self_stiffness);
   EXPECT_FIELD(contact.self_contact);

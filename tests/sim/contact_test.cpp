@@ -224,6 +224,79 @@ TEST(SdfContact, ADynamicObjectGetsTheOppositeForceAndTheChainRuleThroughItsPose
   EXPECT_LT(rep[0].value[1], 0) << "the lid, above the body, pushes it down";
 }
 
+TEST(SdfContact, FrictionDerivativesMatchFiniteDifferencesWhileStickingAndSliding) {
+  // A dynamic lid pressed into the top; the body at t − h was displaced
+  // tangentially by `slip` from q (slip < ε: static spring; slip > ε: sliding).
+  const Avatar a = box();
+  auto cube = std::make_shared<geometry::BoxSdf>(Vec3(0.05, 0.02, 0.05));
+  for (double slip : {2e-6, 1e-3}) {
+    SdfContactOptions o;
+    o.stiffness = 2.0e4;
+    o.friction = 0.6;
+    const SdfContactTerm with("lid", PosedPoints::at_surface(a), cube, Isometry::Identity(), true, o);
+    o.friction = 0;
+    const SdfContactTerm without("lid", PosedPoints::at_surface(a), cube, Isometry::Identity(), true, o);
+    std::mt19937 rng(9);
+    std::vector<Bound> bodies{{&a, body_layout(a, true), {}, {}, {}}, {nullptr, rigid_layout(0), {}, {}, {}}};
+    bodies[1].layout.base = bodies[0].layout.size();
+    bodies[0].q = near_rest(a, rng);
+    bodies[0].q_prev = bodies[0].q;
+    for (Isometry& G : bodies[0].q_prev.bones) G.translation() += Vec3(slip, 0, -0.5 * slip);
+    bodies[0].q_prev2 = bodies[0].q_prev;
+    Isometry G = Isometry::Identity();
+    G.translation() = Vec3(0.003, 0.12 + 0.02 - 0.004, 0.001);
+    bodies[1].q.bones = {G};
+    bodies[1].q.z = VecX(0);
+    bodies[1].q_prev = bodies[1].q_prev2 = bodies[1].q;
+    StepContext ctx = bind_bodies(bodies, nullptr);
+    auto cache = begin_term_step(with, ctx);
+    const Derivatives dw = analytic(with, ctx, bodies);
+    StepContext ctx0 = bind_bodies(bodies, nullptr);
+    auto cache0 = begin_term_step(without, ctx0);
+    const Derivatives d0 = analytic(without, ctx0, bodies);
+    ASSERT_GT(dw.E, d0.E) << "no friction energy at slip " << slip;
+    const double fd_eps = slip < 1e-5 ? 1e-8 : 1e-7;
+    EXPECT_LT(rel(dw.grad, fd_gradient(with, ctx, bodies, fd_eps)), 1e-5) << "slip " << slip;
+    // The friction Hessian is exact (not Gauss–Newton): against differences of the friction gradient.
+    const MatX Hf = dw.hess - d0.hess;
+    const int n = total_size(bodies);
+    MatX fd(n, n);
+    for (int i = 0; i < n; ++i) {
+      VecX e = VecX::Zero(n);
+      e[i] = 1e-9;
+      auto grad_at = [&](const VecX& delta) {
+        std::vector<Configuration> q;
+        for (const Bound& b : bodies) q.push_back(retract(b.q, delta, b.layout));
+        StepContext c1 = ctx, c0 = ctx0;
+        for (size_t k = 0; k < bodies.size(); ++k) c1.bound[k].q = c0.bound[k].q = &q[k];
+        VecX g1 = VecX::Zero(n), g0 = VecX::Zero(n);
+        with.evaluate(c1, q[0], &g1, nullptr);
+        without.evaluate(c0, q[0], &g0, nullptr);
+        return VecX(g1 - g0);
+      };
+      fd.col(i) = (grad_at(e) - grad_at(-e)) / 2e-9;
+    }
+    // Compare on the translational columns (the rotational ones add the exponential map's curvature).
+    std::vector<int> trans;
+    for (int j = 0; j < 24; ++j)
+      for (int c = 3; c < 6; ++c) trans.push_back(bodies[0].layout.bone_offset(j) + c);
+    for (int c = 3; c < 6; ++c) trans.push_back(bodies[1].layout.bone_offset(0) + c);
+    double err = 0, scale = 0;
+    for (int r : trans)
+      for (int c : trans) {
+        err = std::max(err, std::abs(Hf(r, c) - fd(r, c)));
+        scale = std::max(scale, std::abs(Hf(r, c)));
+      }
+    EXPECT_LT(err, 1e-4 * scale) << "slip " << slip;
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatX>(Hf).eigenvalues().minCoeff(), -1e-9 * Hf.norm());
+    // Momentum: the friction forces on body and lid are equal and opposite.
+    const VecX gf = dw.grad - d0.grad;
+    Vec3 sum = gf.segment<3>(bodies[1].layout.bone_offset(0) + 3);
+    for (int j = 0; j < 24; ++j) sum += gf.segment<3>(bodies[0].layout.bone_offset(j) + 3);
+    EXPECT_LT(sum.norm(), 1e-9 * gf.norm());
+  }
+}
+
 TEST(SdfContact, BroadPhaseKeepsEveryPenetratingSampleAndNothingFar) {
   const Avatar a = box();
   auto plane = std::make_shared<geometry::PlaneSdf>(Vec3::UnitY(), 0.0);
@@ -400,6 +473,55 @@ TEST(ContactScene, ABallRestingOnAKinematicBodyIsHeldByItsWeight) {
   EXPECT_LT(std::hypot(force.x(), force.z()), 0.02 * m * 9.81);
   const Vec3 v = (sim.state(sc.ball).bones[0].translation() - sim.previous_state(sc.ball).bones[0].translation()) / kH;
   EXPECT_LT(v.norm(), 1e-3) << "the ball has not come to rest";
+}
+
+/// Where a dynamic slab resting on the flat top of a kinematic box ends after
+/// 1 s with gravity tilted by `tilt` rad (an incline of that angle) and friction μ.
+Vec3 slab_on_incline(double tilt, double mu) {
+  const Avatar a = box(6, 6, 0.01);  // 6 cm top at y = 0.03, vertices 1 cm apart
+  ModelOptions mo;
+  mo.h = kH;
+  mo.gravity = 9.81 * Vec3(std::sin(tilt), -std::cos(tilt), 0);
+  mo.newton.iterations = 4;
+  mo.newton.line_search = true;
+  ModelBuilder mb(mo);
+  const int body = mb.add_body({"box", std::make_shared<const Avatar>(a), false});
+  const int slab = mb.add_body({"slab", nullptr, true});
+  add_soft_tissue_terms(mb, body, {true, 0.0});
+  const double m = 0.1;
+  // Wider than the top, so that no skin sample meets its side faces before it
+  // has slid 3 cm (a sample at a face edge would hook the slab).
+  const Vec3 half(0.06, 0.005, 0.06);
+  add_rigid_body_terms(mb, slab, m, m / 3 * Vec3(half.y() * half.y() + half.z() * half.z(),
+                                                 half.x() * half.x() + half.z() * half.z(),
+                                                 half.x() * half.x() + half.y() * half.y()).asDiagonal().toDenseMatrix());
+  SdfContactOptions co;
+  co.stiffness = 2.0e5;
+  co.friction = mu;
+  mb.add_term(std::make_shared<const SdfContactTerm>("slab", PosedPoints::at_surface(a),
+                                                     std::make_shared<geometry::BoxSdf>(half), Isometry::Identity(), true,
+                                                     co),
+              {body, slab});
+  Simulator sim(mb.build());
+  State s = sim.scene_state();
+  s.bodies[slab].q.bones[0].translation() = Vec3(0, 0.03 + half.y() - 0.0002, 0);
+  s.bodies[slab].q_prev = s.bodies[slab].q;
+  sim.set_state(s);
+  StepInputs in;
+  in.bodies.resize(2);
+  in.bodies[body].bones = identity_bones();
+  for (int i = 0; i < 60; ++i) sim.step(in);
+  return sim.state(slab).bones[0].translation() - Vec3(0, 0.03 + half.y() - 0.0002, 0);
+}
+
+TEST(ContactScene, FrictionHoldsASlabOnAnInclineAboveTheFrictionAngleOnly) {
+  // 15° incline: tan = 0.27. μ = 0.5 holds it; μ = 0.1 lets it slide, about
+  // ½ g (sin θ − μ cos θ) t² = 0.79 m in 1 s if nothing stopped it (the
+  // slab's side meets the top's last samples after 3 cm).
+  const double tilt = 15 * M_PI / 180;
+  const Vec3 stuck = slab_on_incline(tilt, 0.5), slid = slab_on_incline(tilt, 0.1);
+  EXPECT_LT(std::abs(stuck.x()), 2e-3) << "held by friction: " << stuck.transpose();
+  EXPECT_GT(slid.x(), 0.02) << "should slide: " << slid.transpose();
 }
 
 TEST(ContactScene, ABallThrownAtAFreeBodyConservesLinearMomentum) {

@@ -31,6 +31,7 @@
 //                               # (an avatar dropped 0.4 m onto the floor: 4.2 mm deepest)
 //       body_body: 1.0e6        # bone capsules of different bodies; default 1e6
 //       self: 1.0e5             # non-adjacent capsules of one body; default 1e5
+//     friction: 0.5             # Coulomb μ between skin and rigid objects (>= 0); default 0.5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
 //     pairs: all                # default all: every body-object and body-body pair;
@@ -157,6 +158,7 @@ struct ContactDescription {
   double body_object_stiffness = 2.0e5;  ///< N/m per skin sample
   double body_body_stiffness = 1.0e6;    ///< N/m per capsule pair
   double self_stiffness = 1.0e5;         ///< N/m per capsule pair of one body
+  double friction = 0.5;                 ///< Coulomb μ, skin against rigid objects
   bool self_contact = false;
   double sample_spacing = 0;             ///< m; 0 = every skin vertex
   /// true: every body–object and body–body pair collides; false: only `pairs`.

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
 
 namespace sflsh {
 namespace {
@@ -13,7 +14,23 @@ namespace {
 struct ContactCache : TermCache {
   std::vector<int> candidates;
   Isometry frame_pose = Isometry::Identity();  // static/kinematic: the field's pose at t + h
+  /// Friction, per candidate (lagged at time t): normal force, normal, position,
+  /// and (kinematic objects) where the object carries that point by t + h.
+  std::vector<double> lambda;
+  std::vector<Vec3> normal, x_t, carried;
+  Isometry object_t = Isometry::Identity();    // dynamic: the object's body pose at t
 };
+
+/// IPC's friction mollifier: f1 = f0′ and f1′ at slip z ≥ 0 (ε > 0).
+void mollifier(double z, double eps, double& f0, double& f1, double& df1) {
+  if (z >= eps) {
+    f0 = z, f1 = 1, df1 = 0;
+  } else {
+    f0 = z * z / eps - z * z * z / (3 * eps * eps) + eps / 3;
+    f1 = 2 * z / eps - z * z / (eps * eps);
+    df1 = 2 / eps - 2 * z / (eps * eps);
+  }
+}
 
 ContactCache& contact_cache(const StepContext& ctx, const std::string& name) {
   require(ctx.cache != nullptr, name, ": no cache (call begin_step through begin_term_step or the integrator)");
@@ -36,6 +53,8 @@ SdfContactTerm::SdfContactTerm(std::string object, PosedPoints samples, geometry
   require(field_ != nullptr, "contact with '", object_, "': no field");
   require(o.stiffness >= 0 && std::isfinite(o.stiffness), "contact with '", object_, "': stiffness ", o.stiffness,
           " N/m, expected >= 0");
+  require(o.friction >= 0 && std::isfinite(o.friction) && o.static_slip_speed > 0, "contact with '", object_,
+          "': friction must be >= 0 and the static slip speed > 0");
   require(o.margin >= 0 && o.cluster_slack >= 0 && o.cluster_size > 0, "contact with '", object_,
           "': margin, slack must be >= 0 and the cluster size > 0");
   // Clusters: samples by dominant bone and unposed cell.
@@ -110,6 +129,29 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
     for (int p : cl.samples)
       if (field_->distance(T_inv * samples_.world_point(p, qt)) < reach) c.candidates.push_back(p);
   }
+  // Friction data at time t (header comment).
+  const size_t n = c.candidates.size();
+  c.lambda.assign(n, 0.0);
+  c.normal.assign(n, Vec3::Zero());
+  c.x_t.assign(n, Vec3::Zero());
+  c.carried.assign(n, Vec3::Zero());
+  if (options_.friction <= 0) return;
+  if (dynamic_) c.object_t = ctx.bound[1].q_prev->bones[0];
+  Vec3 v = Vec3::Zero(), w = Vec3::Zero(), origin = T.translation();
+  if (!dynamic_) {
+    const WorldFrame& f = ctx.frames->at(object_);
+    v = f.linear_velocity, w = f.angular_velocity;
+    origin = f.pose.translation() - v * ctx.h;  // the frame's origin at t
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 x = samples_.world_point(c.candidates[i], qt);
+    const geometry::SdfSample sd = field_->evaluate(T_inv * x);
+    if (!(sd.distance < 0)) continue;
+    c.lambda[i] = options_.stiffness * -sd.distance;
+    c.normal[i] = (T.linear() * sd.gradient).normalized();
+    c.x_t[i] = x;
+    c.carried[i] = x + ctx.h * (v + w.cross(x - origin));
+  }
 }
 
 bool SdfContactTerm::active(const StepContext& ctx) const { return !candidates(ctx).empty(); }
@@ -125,8 +167,15 @@ double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, V
   std::vector<int> cols;
   VecX g;
   double E = 0;
-  for (int p : cand) {
+  const ContactCache& cc = contact_cache(ctx, name());
+  const double mu = options_.friction, eps = options_.static_slip_speed * ctx.h;
+  // A dynamic object carries the point it touched at t by G(q) G_t⁻¹.
+  const Isometry carry = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * cc.object_t.inverse()) : Isometry::Identity();
+  for (size_t i = 0; i < cand.size(); ++i) {
+    const int p = cand[i];
     const Vec3 x = samples_.world_point(p, q);
+    if (mu > 0 && cc.lambda[i] > 0) E += friction(ctx, q, p, x, cc.lambda[i], cc.normal[i],
+                                                  dynamic_ ? Vec3(carry * cc.x_t[i]) : cc.carried[i], mu, eps, grad, hess);
     const geometry::SdfSample s = field_->evaluate(T_inv * x);
     const double d = s.distance;
     if (!(d < 0)) continue;
@@ -162,20 +211,86 @@ double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, V
   return E;
 }
 
+double SdfContactTerm::friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda,
+                                const Vec3& n, const Vec3& y, double mu, double eps, VecRef* grad, MatRef* hess) const {
+  const Mat3 P = Mat3::Identity() - n * n.transpose();
+  const Vec3 s = P * (x - y);
+  const double z = s.norm();
+  double f0, f1, df1;
+  mollifier(z, eps, f0, f1, df1);
+  const double c = mu * lambda;
+  if (!grad && !hess) return c * f0;
+  // ∂D/∂s and ∂²D/∂s² (header comment), pulled back through P.
+  const Vec3 g = z > 0 ? Vec3(c * f1 / z * s) : Vec3::Zero();
+  Mat3 Hs = (2 / eps) * Mat3::Identity();
+  if (z > 0) Hs = (f1 / z) * Mat3::Identity() + (df1 - f1 / z) / (z * z) * s * s.transpose();
+  Hs *= c;
+  const Mat3 H = P * Hs * P;
+  const DofLayout& L = ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  samples_.local_jacobian(p, q, L, J, cols);
+  const int m = int(cols.size());
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> HJ = H * J;
+  // The object's point y moves by ω × y + v: ∂(x − y)/∂ξ_object = −[−[y]×, I].
+  Eigen::Matrix<double, 3, 6> Jy;
+  if (dynamic_) Jy << -hat(y), Mat3::Identity();
+  const int ob = dynamic_ ? ctx.bound[1].layout.base : -1;
+  if (grad) {
+    const VecX gb = J.transpose() * g;
+    for (int a = 0; a < m; ++a) (*grad)[cols[a]] += gb[a];
+    if (dynamic_) grad->segment<6>(ob) -= Jy.transpose() * g;
+  }
+  if (hess) {
+    const MatX Hbb = J.transpose() * HJ;
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < m; ++b) (*hess)(cols[a], cols[b]) += Hbb(a, b);
+    if (dynamic_) {
+      hess->block<6, 6>(ob, ob) += Jy.transpose() * H * Jy;
+      const Eigen::Matrix<double, 6, Eigen::Dynamic> Hob = -(Jy.transpose() * HJ);
+      for (int a = 0; a < m; ++a)
+        for (int r = 0; r < 6; ++r) {
+          (*hess)(ob + r, cols[a]) += Hob(r, a);
+          (*hess)(cols[a], ob + r) += Hob(r, a);
+        }
+    }
+  }
+  return c * f0;
+}
+
 std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const Configuration& q) const {
   const Isometry T = field_pose(ctx);
   const Isometry T_inv = T.inverse();
-  Vec3 force = Vec3::Zero();
+  Vec3 force = Vec3::Zero(), friction_force = Vec3::Zero();
   int active = 0;
   double depth = 0;
-  for (int p : candidates(ctx)) {
+  const ContactCache& cc = contact_cache(ctx, name());
+  const std::vector<int>& cand = candidates(ctx);
+  if (options_.friction > 0) {
+    // −∂D/∂x of every sample with a lagged normal force: D's gradient on the
+    // body's translation (the bones' v columns sum ∂x/∂v = I for each sample).
+    const Isometry carry = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * cc.object_t.inverse()) : Isometry::Identity();
+    const double eps = options_.static_slip_speed * ctx.h;
+    for (size_t i = 0; i < cand.size(); ++i) {
+      if (!(cc.lambda[i] > 0)) continue;
+      const Vec3 y = dynamic_ ? Vec3(carry * cc.x_t[i]) : cc.carried[i];
+      const Vec3& n = cc.normal[i];
+      const Vec3 s = (Mat3::Identity() - n * n.transpose()) * (samples_.world_point(cand[i], q) - y);
+      double f0, f1, df1;
+      mollifier(s.norm(), eps, f0, f1, df1);
+      if (s.norm() > 0) friction_force -= options_.friction * cc.lambda[i] * f1 * s.normalized();
+    }
+  }
+  force += friction_force;
+  for (int p : cand) {
     const geometry::SdfSample s = field_->evaluate(T_inv * samples_.world_point(p, q));
     if (!(s.distance < 0)) continue;
     force -= options_.stiffness * s.distance * (T.linear() * s.gradient);
     ++active;
     depth = std::max(depth, -s.distance);
   }
-  return {{"force", "N", force}, {"active_samples", "", VecX::Constant(1, active)},
+  return {{"force", "N", force}, {"friction_force", "N", friction_force},
+          {"active_samples", "", VecX::Constant(1, active)},
           {"max_penetration", "m", VecX::Constant(1, depth)}};
 }
 

@@ -20,6 +20,18 @@
 //     order, whatever the pivot), so the forces on body and object are equal
 //     and opposite and momentum is conserved.
 //
+// Friction (Coulomb, lagged per step; Li et al. 2020, "Incremental Potential
+// Contact" §5): a sample in contact at time t, with normal force
+// λ = k·max(0, −φ(x_t)) and normal n at x_t, gets the dissipative potential
+//   D = μ λ f0(|s|),   s = (I − n nᵀ)(x(q) − y(q)),
+// where y is where the object carries the point it touched at t (so s is the
+// tangential slip over the step) and f0 the C¹ mollifier of |s| below
+// ε = ε_v h (f0 = z²/ε − z³/(3ε²) + ε/3 for z < ε, z beyond): static friction
+// as a stiff tangential spring up to μλ, sliding friction μλ against the
+// slip beyond. Its Hessian μλ P[(f1/z) I + (f1′ − f1/z) ŝŝᵀ]P is PSD. λ, n,
+// x_t are frozen for the step (begin_step), so a sample starts to feel
+// friction one step after touching.
+//
 // Broad phase (begin_step): the samples are grouped into clusters (dominant
 // bone × a cell of `cluster_size` in the unposed space) with a bounding
 // sphere; a cluster is kept only if φ at its centre, carried by its bone at
@@ -45,6 +57,9 @@ struct SdfContactOptions {
   /// skinning and soft displacement away from the dominant bone's rigid motion.
   double cluster_slack = 0.05;
   double cluster_size = 0.1;  ///< m, cluster cell in the unposed space
+  double friction = 0.0;      ///< μ, Coulomb coefficient (0 = frictionless)
+  /// Slip speed (m/s) below which friction acts as a spring (ε = this·h).
+  double static_slip_speed = 1e-3;
 };
 
 class SdfContactTerm : public EnergyTerm {
@@ -60,7 +75,8 @@ class SdfContactTerm : public EnergyTerm {
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
-  /// "force" (3, N: what the object exerts on the body, world), "active_samples"
+  /// "force" (3, N: what the object exerts on the body, world; normal and
+  /// friction), "friction_force" (3, N, its friction part), "active_samples"
   /// (1: samples with φ < 0) and "max_penetration" (1, m) at the final q.
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
@@ -73,6 +89,10 @@ class SdfContactTerm : public EnergyTerm {
   const std::vector<int>& candidates(const StepContext& ctx) const;
 
  private:
+  /// Friction potential of sample p at x (header comment), y = where the object
+  /// carries the touched point; adds its gradient/Hessian.
+  double friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda, const Vec3& n,
+                  const Vec3& y, double mu, double eps, VecRef* grad, MatRef* hess) const;
   struct Cluster {
     int bone = 0;
     Vec3 center = Vec3::Zero();  ///< unposed, m
