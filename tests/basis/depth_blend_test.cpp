@@ -30,12 +30,7 @@ BbwOptions quiet(BoneCondition c = BoneCondition::DepthBlend) {
 /// A 0.3 m cube of flesh on a bone face y = 0 (6 cubes a side).
 struct Cube {
   TetMesh mesh = test::box_tet_mesh(6, 6, 6, 0.3, 0.3, 0.3);
-  VecXi role;
-  Cube() {
-    role = VecXi::Zero(mesh.num_nodes());
-    for (int i = 0; i < mesh.num_nodes(); ++i)
-      if (mesh.nodes(i, 1) < 1e-12) role(i) = int(NodeRole::Bone);
-  }
+  VecXi role = test::bone_floor_roles(mesh);
 };
 
 TEST(DepthFraction, ZeroAtBoneOneOnSkinHarmonicInside) {
