@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "basis/cholmod_llt.hpp"
+#include "sflsh/basis/depth_fraction.hpp"
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
@@ -214,6 +215,8 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
   res.x = VecX::Zero(n);
   std::vector<char> state(n);
   for (int i = 0; i < n; ++i) state[i] = dist(i) <= radius ? kFree : kLower;
+  std::vector<int> released(n, 0);  // releases in the conservative phase, see below
+  std::vector<char> frozen(n, 0);
 
   InactiveSetSolver solver(A, opt.max_border_columns);
   VecX& x = res.x;
@@ -231,7 +234,11 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
     res.factorizations = solver.factorizations();
 
     // Active-set update. Plain PDAS first; after opt.pdas_iterations add-only,
-    // or release-only when nothing is violated, so that it cannot cycle.
+    // or release-only when nothing is violated. A node bound again after
+    // opt.max_releases such releases stays bound ("frozen"): every node is
+    // then released finitely often, so the iteration ends (add/release alone
+    // can cycle on long, thin supports, seen with free bones), and the KKT
+    // residual reports what freezing cost.
     const bool conservative = it > opt.pdas_iterations;
     bool primal_violation = false;
     for (int i = 0; i < n; ++i)
@@ -241,14 +248,18 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
       if (state[i] == kFree) {
         if (x(i) < 0.0) state[i] = kLower, changed = true;
         else if (x(i) > 1.0) state[i] = kUpper, changed = true;
-      } else if (!(conservative && primal_violation)) {
+        if (state[i] != kFree && released[i] >= opt.max_releases) frozen[i] = 1;
+      } else if (!(conservative && (primal_violation || frozen[i]))) {
         if ((state[i] == kLower && g(i) < -mtol) || (state[i] == kUpper && g(i) > mtol)) {
           state[i] = kFree;
+          if (conservative) ++released[i];
           changed = true;
         }
       }
     }
-    if (!changed) {
+    // Settled, or converged to within kkt_tolerance while nodes at the C¹
+    // support boundary still toggle at round-off level (seen with free bones).
+    if (!changed || res.history.back() <= opt.kkt_tolerance) {
       x = x.cwiseMax(0.0).cwiseMin(1.0);  // round-off on the inactive set
       return res;
     }
@@ -295,7 +306,8 @@ std::string BbwReport::summary() const {
   if (nonzeros > 0)
     os << "  W: " << nonzeros << " nonzeros, bound violation " << max_bound_violation << ", partition-of-unity error "
        << partition_error << ", max Σ_k w_k before normalization " << max_sum_before_normalization << " ("
-       << nodes_normalized << " rows rescaled)\n";
+       << nodes_normalized << " rows rescaled" << (nodes_unreached ? ", " + std::to_string(nodes_unreached) + " Simulated rows no handle reaches" : std::string())
+       << ")\n";
   os << "  time: operators " << seconds_setup << " s, active set " << seconds_active_set << " s";
   return os.str();
 }
@@ -454,6 +466,9 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> bounded_biharmonic_weights(const Te
     require(!is_handle[i], "bounded biharmonic weights: handles share node ", i);
     is_handle[i] = 1;
   }
+  const bool blend = options.bone_condition == BoneCondition::DepthBlend;
+  require(!blend || options.normalization_floor > 0.0,
+          "bounded biharmonic weights: normalization_floor must be positive, got ", options.normalization_floor);
   std::vector<int> fixed;
   std::vector<int> value_col;  // handle column with value 1, or −1 for a Dirichlet zero
   for (int k = 0; k < K; ++k) fixed.push_back(handle_nodes(k)), value_col.push_back(k);
@@ -461,7 +476,9 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> bounded_biharmonic_weights(const Te
     const int role = node_role(i);
     require(role >= 0 && role <= 2, "bounded biharmonic weights: node_role(", i, ") = ", role,
             ", expected 0 (Simulated), 1 (Skinned) or 2 (Bone)");
-    if (role != int(NodeRole::Simulated)) fixed.push_back(i), value_col.push_back(-1);
+    // DepthBlend: bone nodes are free in the QPs (their rows are zeroed below).
+    if (role == int(NodeRole::Skinned) || (role == int(NodeRole::Bone) && !blend))
+      fixed.push_back(i), value_col.push_back(-1);
   }
   VecXi fixed_v = Eigen::Map<VecXi>(fixed.data(), Eigen::Index(fixed.size()));
   MatX values = MatX::Zero(Eigen::Index(fixed.size()), K);
@@ -472,12 +489,19 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> bounded_biharmonic_weights(const Te
   BbwReport& r = report ? *report : local;
   MatX Wd = bounded_biharmonic_qp(mesh, fixed_v, values, options, &r);
 
-  // Rescale rows with Σ_k w_k > 1 (see the header) and sparsify.
+  // Dirichlet: rescale rows with Σ_k w_k > 1. DepthBlend: every Simulated row
+  // to b_i · w̃ / max(Σ w̃, floor), other rows 0 (see the header). Then sparsify.
+  const VecX depth = blend ? depth_fraction(mesh, node_role) : VecX();
   std::vector<Eigen::Triplet<double>> trip;
   for (int i = 0; i < n; ++i) {
     const double s = Wd.row(i).sum();
+    if (blend && node_role(i) != int(NodeRole::Simulated)) continue;
     r.max_sum_before_normalization = std::max(r.max_sum_before_normalization, s);
-    if (s > 1.0) {
+    if (blend) {
+      if (s < options.normalization_floor) ++r.nodes_unreached;
+      else ++r.nodes_normalized;
+      Wd.row(i) *= depth[i] / std::max(s, options.normalization_floor);
+    } else if (s > 1.0) {
       Wd.row(i) /= s;
       ++r.nodes_normalized;
     }

@@ -4,13 +4,17 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <memory>
 
+#include "sflsh/bench/subspace_floor.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "sflsh/sim/full_fem.hpp"
@@ -23,9 +27,12 @@ constexpr double kFrameRate = 30.0;  // comparison frames per simulated second
 
 /// Soft displacement of the skin at the comparison frames plus step timings.
 struct Trace {
-  std::vector<Points> u;   // per frame, #V by 3 (m)
-  std::vector<double> ms;  // per step
+  std::vector<Points> u;      // per frame, #V by 3 (m)
+  std::vector<double> ms;     // per step
+  std::vector<Points> nodal;  // reference only: per frame, #N by 3 nodal soft displacement (m)
 };
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Steps per comparison frame for time step h (h must divide 1/30 s).
 int steps_per_frame(double h) {
@@ -46,13 +53,17 @@ Trace run_reference(std::shared_ptr<const Avatar> avatar, const MotionClip& moti
   fem.reset(target_bones(*avatar, motion.sample(0)));
   Trace tr;
   tr.u.push_back(fem.soft_displacement());
+  tr.nodal.push_back(fem.displacement());
   const int per = steps_per_frame(h);
   const long steps = std::lround(seconds / h);
   Progress p("bench: full-FEM reference", steps);
   for (long s = 1; s <= steps; ++s) {
     const FullFemReport rep = fem.step(target_bones(*avatar, motion.sample(s * h)));
     tr.ms.push_back(rep.ms_total);
-    if (s % per == 0) tr.u.push_back(fem.soft_displacement());
+    if (s % per == 0) {
+      tr.u.push_back(fem.soft_displacement());
+      tr.nodal.push_back(fem.displacement());
+    }
     p.update(s);
   }
   p.finish();
@@ -123,6 +134,50 @@ std::vector<int> simulated_region(const Avatar& a) {
   return out;
 }
 
+/// #N lumped nodal masses (kg) of the Simulated nodes (0 at Dirichlet nodes,
+/// where every displacement is 0): ρ_t V_t / 4 per tet corner.
+VecX simulated_nodal_mass(const Avatar& a) {
+  const VecX vol = fem::tet_volumes(a.tet);
+  VecX m = VecX::Zero(a.tet.num_nodes());
+  for (int t = 0; t < a.tet.num_elements(); ++t)
+    for (int c = 0; c < 4; ++c) {
+      const int i = a.tet.elements(t, c);
+      if (a.node_role[i] == int(NodeRole::Simulated)) m[i] += a.materials[a.tet_region[t]].density * std::abs(vol[t]) / 4;
+    }
+  return m;
+}
+
+/// The skin's soft displacement (#V by 3) interpolated from nodal values
+/// (#N by 3) through (surface_tet, surface_bary), Dirichlet nodes held at 0.
+Points surface_from_nodes(const Avatar& a, const Points& nodal) {
+  Points u(a.surface_rest.rows(), 3);
+  for (int v = 0; v < u.rows(); ++v) {
+    Vec3 s = Vec3::Zero();
+    for (int c = 0; c < 4; ++c) {
+      const int i = a.tet.elements(a.surface_tet[v], c);
+      if (a.node_role[i] == int(NodeRole::Simulated)) s += a.surface_bary(v, c) * nodal.row(i).transpose();
+    }
+    u.row(v) = s.transpose();
+  }
+  return u;
+}
+
+/// The floor trace of basis a.W: the skin displacement of the mass-weighted
+/// projection of each reference frame onto span(W ⊗ I₃).
+std::vector<Points> floor_trace(const Avatar& a, const Trace& ref) {
+  const SubspaceProjector proj(a.W, simulated_nodal_mass(a));
+  std::vector<Points> out;
+  for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(a, proj.project(u)));
+  return out;
+}
+
+/// Region label of each skin vertex in `region` (tet_region of its tet), −1 elsewhere.
+VecXi vertex_regions(const Avatar& a, const std::vector<int>& region) {
+  VecXi out = VecXi::Constant(a.surface_rest.rows(), -1);
+  for (int v : region) out[v] = a.tet_region[a.surface_tet[v]];
+  return out;
+}
+
 void compare(const Trace& tr, const Trace& ref, const std::vector<int>& region, BenchRow& row) {
   const size_t F = std::min(tr.u.size(), ref.u.size());
   double diff2 = 0, ref2 = 0, sum = 0, mx = 0, peak = 0, peak_ref = 0;
@@ -145,6 +200,12 @@ void compare(const Trace& tr, const Trace& ref, const std::vector<int>& region, 
   row.peak_ratio = peak_ref > 0 ? peak / peak_ref : 0;
   row.ms_median = percentile(tr.ms, 0.5);
   row.ms_p95 = percentile(tr.ms, 0.95);
+}
+
+const RegionError* region_named(const BenchRow& r, const std::string& name) {
+  for (const auto& g : r.regions)
+    if (g.name == name) return &g;
+  return nullptr;
 }
 
 }  // namespace
@@ -174,26 +235,50 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   mo.builtin_seconds = o.seconds + 0.5;
   const MotionClip motion = load_motion(o.motion, mo);
   const std::vector<int> region = simulated_region(base);
+  const VecXi labels = vertex_regions(base, region);
+  const int num_regions = int(base.materials.size());
+  const VecXi in_region = labels.unaryExpr([](int r) { return r >= 0 ? 0 : -1; });
 
   const double h = o.default_dt;
   const Trace ref = run_reference(default_avatar, motion, o.seconds, h);
   std::vector<BenchRow> rows;
+  // Floors per basis (rows sharing an avatar share it; the map keeps each
+  // avatar alive so that its address is never reused by another).
+  std::map<std::shared_ptr<const Avatar>, std::vector<Points>> floors;
+  auto floor_of = [&](const std::shared_ptr<const Avatar>& a) -> const std::vector<Points>* {
+    if (!a) return nullptr;
+    auto it = floors.find(a);
+    if (it == floors.end()) it = floors.emplace(a, floor_trace(*a, ref)).first;
+    return &it->second;
+  };
+  // rel_err and floor per region, and the overall floor.
+  auto split = [&](const Trace& tr, const std::shared_ptr<const Avatar>& a, BenchRow& r) {
+    const std::vector<Points>* fl = floor_of(a);
+    r.floor_rel_err = fl ? region_rel_errors(*fl, ref.u, in_region, 1)[0] : kNaN;
+    const std::vector<double> e = region_rel_errors(tr.u, ref.u, labels, num_regions);
+    const std::vector<double> ef = fl ? region_rel_errors(*fl, ref.u, labels, num_regions) : std::vector<double>();
+    for (int g = 0; g < num_regions; ++g)
+      if (std::isfinite(e[size_t(g)])) r.regions.push_back({base.materials[size_t(g)].name, e[size_t(g)], fl ? ef[size_t(g)] : kNaN});
+  };
   BenchRow rr{"reference", "full FEM, Newton to convergence", 0, h, -1, false};
   compare(ref, ref, region, rr);
+  split(ref, nullptr, rr);
   rows.push_back(rr);
   const double ref_ms = rr.ms_median;
 
-  auto add = [&](const Trace& tr, const std::string& method, const std::string& label, int K, double dt, int iters,
-                 bool is_default) {
+  auto add = [&](const Trace& tr, const std::shared_ptr<const Avatar>& a, const std::string& method, const std::string& label, int K,
+                 double dt, int iters, bool is_default) {
     BenchRow r{method, label, K, dt, iters, is_default};
     compare(tr, ref, region, r);
+    split(tr, a, r);
     r.speedup = r.ms_median > 0 ? ref_ms / r.ms_median : 0;
     rows.push_back(r);
   };
   auto reduced = [&](std::shared_ptr<const Avatar> a, int K, double dt, int iters, const std::string& what,
                      bool is_default) {
     const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
-    add(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label), "reduced", label, K, dt, iters, is_default);
+    add(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label), a, "reduced", label, K, dt, iters,
+        is_default);
   };
   const int K = o.default_handles;
   // Handle counts at the default time step and cubature, one Newton step.
@@ -215,6 +300,18 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
     reduced(a, K, h, 1, what + " (" + std::to_string(a->elastic.size()) + " samples)", false);
   };
+  // The basis before issue 13 (bones Dirichlet 0 in every QP), for its floor
+  // and its simulation next to the default's.
+  {
+    PrecomputeOptions po = o.precompute;
+    po.handles = K;
+    po.bbw.bone_condition = po.bbw.bone_condition == basis::BoneCondition::Dirichlet ? basis::BoneCondition::DepthBlend
+                                                                                     : basis::BoneCondition::Dirichlet;
+    const bool dirichlet = po.bbw.bone_condition == basis::BoneCondition::Dirichlet;
+    log_info("bench: shape stage with bones " + std::string(dirichlet ? "Dirichlet" : "depth-blended"));
+    const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
+    reduced(a, K, h, 1, dirichlet ? "bones Dirichlet 0 (before issue 13)" : "bones depth-blended", false);
+  }
   const PrecomputeOptions defaults = o.precompute;
   cubature_variant(defaults.elastic_samples_per_cell, !defaults.fit_elastic_cubature,
                    std::string(defaults.fit_elastic_cubature ? "no" : "with") + " stiffness fit");
@@ -230,7 +327,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     exact_both->inertia = basis::full_cubature(exact->tet);
     reduced(exact_both, K, h, 1, "elastic + inertia on all tets", false);
   }
-  add(run_skinning(base, motion, o.seconds, h), "skinning", "skinning only (u = 0)", 0, h, 0, false);
+  add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }
 
@@ -239,13 +336,25 @@ void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path)
   {
     std::ofstream f(tmp);
     if (!f) fail(path, ": cannot write");
-    f << "method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio\n";
+    // Region columns follow the first row's regions (the reference lists
+    // every region with reference motion; a row without one writes nan).
+    const std::vector<RegionError> names = rows.empty() ? std::vector<RegionError>() : rows[0].regions;
+    f << "method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio,"
+         "floor_rel_err";
+    for (const auto& g : names) f << ",rel_err_" << g.name << ",floor_" << g.name;
+    f << "\n";
     char buf[512];
     for (const auto& r : rows) {
-      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g\n", r.method.c_str(), r.handles,
-                    r.dt, r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup, r.err_mean_mm,
-                    r.err_max_mm, r.rel_err, r.peak_ratio);
+      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g", r.method.c_str(),
+                    r.handles, r.dt, r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup,
+                    r.err_mean_mm, r.err_max_mm, r.rel_err, r.peak_ratio, r.floor_rel_err);
       f << buf;
+      for (const auto& g : names) {
+        const RegionError* e = region_named(r, g.name);
+        std::snprintf(buf, sizeof buf, ",%.4g,%.4g", e ? e->rel_err : kNaN, e ? e->floor_rel_err : kNaN);
+        f << buf;
+      }
+      f << "\n";
     }
     if (!f) fail(path, ": write failed");
   }
@@ -256,14 +365,41 @@ void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& 
   std::ofstream f(path + ".partial");
   if (!f) fail(path, ": cannot write");
   f << "| method | variant | K | dt (s) | Newton iters | ms/step median | p95 | speedup | err mean (mm) | err max (mm) "
-       "| rel_err | peak ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| rel_err | floor | peak ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[512];
+  auto num = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3f", v);
+    return std::isfinite(v) ? std::string(b) : std::string("–");
+  };
+  auto bold_default = [](const BenchRow& r, const std::string& line) {
+    return r.is_default ? std::string(line).replace(2, r.method.size(), "**" + r.method + "**") : line;
+  };
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "| %s | %s | %d | 1/%.0f | %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3f | %.3f |\n",
+    std::snprintf(buf, sizeof buf, "| %s | %s | %d | 1/%.0f | %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3f | %s | %.3f |\n",
                   r.method.c_str(), r.label.c_str(), r.handles, 1.0 / r.dt,
                   r.newton_iters < 0 ? "to convergence" : std::to_string(r.newton_iters).c_str(), r.ms_median,
-                  r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm, r.rel_err, r.peak_ratio);
-    f << (r.is_default ? std::string(buf).replace(2, r.method.size(), "**" + r.method + "**") : std::string(buf));
+                  r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm, r.rel_err, num(r.floor_rel_err).c_str(),
+                  r.peak_ratio);
+    f << bold_default(r, buf);
+  }
+  // Per region: simulated rel_err / floor.
+  const std::vector<RegionError> names = rows.empty() ? std::vector<RegionError>() : rows[0].regions;
+  if (!names.empty()) {
+    f << "\nrel_err per region (simulated / floor):\n\n| method | variant |";
+    for (const auto& g : names) f << ' ' << g.name << " |";
+    f << "\n|---|---|";
+    for (size_t i = 0; i < names.size(); ++i) f << "---|";
+    f << "\n";
+    for (const auto& r : rows) {
+      std::string line = "| " + r.method + " | " + r.label + " |";
+      for (const auto& g : names) {
+        const RegionError* e = region_named(r, g.name);
+        line += " " + (e ? num(e->rel_err) + (std::isfinite(e->floor_rel_err) ? " / " + num(e->floor_rel_err) : "")
+                         : std::string("–")) + " |";
+      }
+      f << bold_default(r, line + "\n");
+    }
   }
   if (!f) fail(path, ": write failed");
   f.close();

@@ -183,7 +183,8 @@ std::string key_prefix(const BodyModel& model, const PrecomputeOptions& o) {
   for (Eigen::Index i = 0; i < o.handle_positions.size(); ++i) s << ',' << o.handle_positions.data()[i];
   s << "|placement," << o.placement.thickness_exponent << ',' << o.placement.seed;
   s << "|bbw," << o.bbw.max_iterations << ',' << o.bbw.pdas_iterations << ',' << o.bbw.multiplier_tolerance << ','
-    << o.bbw.drop_tolerance << ',' << o.bbw.initial_radius_factor << ',' << o.bbw.max_border_columns;
+    << o.bbw.drop_tolerance << ',' << o.bbw.initial_radius_factor << ',' << o.bbw.max_border_columns << ','
+    << int(o.bbw.bone_condition) << ',' << o.bbw.normalization_floor << ',' << o.bbw.kkt_tolerance << ',' << o.bbw.max_releases;
   s << "|cubature," << o.elastic_samples_per_cell << ',' << o.fit_elastic_cubature << "|betas";
   return s.str();
 }

@@ -13,9 +13,14 @@
 namespace sflsh::basis {
 namespace {
 
+// These tests check Jacobson et al.'s formulation (bones Dirichlet 0) and
+// the QP solver to round-off (no early stop); the default DepthBlend basis is
+// tested in depth_blend_test.cpp.
 BbwOptions quiet() {
   BbwOptions o;
   o.show_progress = false;
+  o.bone_condition = BoneCondition::Dirichlet;
+  o.kkt_tolerance = 0.0;
   return o;
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 
+#include "sflsh/asset/avatar.hpp"
 #include "sflsh/mesh/tet_mesh.hpp"
 
 namespace sflsh::test {
@@ -37,6 +38,14 @@ inline TetMesh box_tet_mesh(int nx, int ny, int nz, double a, double b, double c
         } while (std::next_permutation(perm.begin(), perm.end()));
       }
   return m;
+}
+
+/// #N NodeRole: Bone on the face y = 0 (a "bone" under the flesh), Simulated elsewhere.
+inline VecXi bone_floor_roles(const TetMesh& m) {
+  VecXi role = VecXi::Constant(m.num_nodes(), int(NodeRole::Simulated));
+  for (int i = 0; i < m.num_nodes(); ++i)
+    if (m.nodes(i, 1) < 1e-12) role(i) = int(NodeRole::Bone);
+  return role;
 }
 
 }  // namespace sflsh::test

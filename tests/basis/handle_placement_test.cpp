@@ -13,12 +13,7 @@ namespace {
 
 struct Slab {
   TetMesh mesh = test::box_tet_mesh(16, 3, 8, 0.4, 0.06, 0.2);
-  VecXi role;
-  Slab() {
-    role = VecXi::Zero(mesh.num_nodes());
-    for (int i = 0; i < mesh.num_nodes(); ++i)
-      if (mesh.nodes(i, 1) < 1e-12) role(i) = int(NodeRole::Bone);
-  }
+  VecXi role = test::bone_floor_roles(mesh);
 };
 
 TEST(HandlePlacement, DeterministicDistinctSimulated) {

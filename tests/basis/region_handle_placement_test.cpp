@@ -10,6 +10,7 @@
 
 #include "box_mesh.hpp"
 #include "limbed_body_mesh.hpp"
+#include "mesh_boundary.hpp"
 #include "sflsh/basis/basis_coverage.hpp"
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/handle_placement.hpp"
@@ -25,22 +26,7 @@ HandlePlacementOptions old_options() {
   return o;
 }
 
-/// Outer-surface nodes, found independently of the library: nodes of the tet
-/// faces that belong to exactly one tet.
-std::vector<int> boundary_nodes(const TetMesh& m) {
-  std::map<std::array<int, 3>, int> count;
-  static const int faces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  for (int t = 0; t < m.num_elements(); ++t)
-    for (const auto& f : faces) {
-      std::array<int, 3> key = {m.elements(t, f[0]), m.elements(t, f[1]), m.elements(t, f[2])};
-      std::sort(key.begin(), key.end());
-      ++count[key];
-    }
-  std::set<int> nodes;
-  for (const auto& [key, c] : count)
-    if (c == 1) nodes.insert(key.begin(), key.end());
-  return {nodes.begin(), nodes.end()};
-}
+using test::boundary_nodes;
 
 struct Coverage {
   int skin[3] = {0, 0, 0}, covered[3] = {0, 0, 0};
@@ -69,9 +55,12 @@ std::array<int, 3> handles_per_region(const HandleSet& hs) {
   return n;
 }
 
+// The placement's effect is measured on the basis it was made for (bones
+// Dirichlet 0); depth_blend_test.cpp covers the default basis on this body.
 BbwOptions quiet() {
   BbwOptions o;
   o.show_progress = false;
+  o.bone_condition = BoneCondition::Dirichlet;
   return o;
 }
 

@@ -10,6 +10,11 @@
 //   err_*_mm   = mean / max over those vertices and frames of |u − u_ref| (mm)
 //   peak_ratio = max |u| / max |u_ref|
 //   speedup    = reference median step time / method median step time
+//   floor      = rel_err of the best approximation of the reference within the
+//                row's basis span(W ⊗ I₃), mass-weighted least squares per frame
+//                on the tet nodes (subspace_floor.hpp): the basis error alone
+//   per region = rel_err and floor over the skin vertices of one body region
+//                (the material region of the vertex's tet: belly, chest, ...)
 #include <string>
 #include <vector>
 
@@ -30,6 +35,12 @@ struct BenchOptions {
   PrecomputeOptions precompute;           ///< template/shape options (cache dir, ...)
 };
 
+/// rel_err of one body region (NaN when the region has no reference motion).
+struct RegionError {
+  std::string name;
+  double rel_err = 0, floor_rel_err = 0;
+};
+
 struct BenchRow {
   std::string method;  ///< reference | reduced | skinning
   std::string label;   ///< the variant in words (table, plot legend; not in the CSV)
@@ -39,6 +50,10 @@ struct BenchRow {
   bool is_default = false;
   double ms_median = 0, ms_p95 = 0, speedup = 0;
   double err_mean_mm = 0, err_max_mm = 0, rel_err = 0, peak_ratio = 0;
+  /// Subspace floor (reduced rows; NaN for the others, which have no basis).
+  double floor_rel_err = 0;
+  /// Per simulated body region, in the avatar's region order.
+  std::vector<RegionError> regions;
 };
 
 /// Runs every variant (progress on stderr) and returns one row each.
@@ -46,8 +61,10 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& options);
 
 /// CSV with the header
 /// method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio
+/// followed by floor_rel_err and, per region of the first row, rel_err_<name>,floor_<name>.
 void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path);
-/// The rows as a Markdown table (with labels), for the README.
+/// The rows as a Markdown table (with labels and the floor), then a table of
+/// rel_err / floor per region, for the README.
 void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& path);
 /// Log-log scatter of rel_err against ms per step, as SVG.
 void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& path, const std::string& title);

@@ -1,0 +1,44 @@
+#pragma once
+// The error floor of a reduced basis (issue 13): the best approximation of a
+// nodal soft displacement within span(U), U = W ⊗ I₃ (u_i = Σ_k W_ik z_k),
+// in the mass-weighted least-squares sense, per frame:
+//   z* = argmin_z Σ_i m_i ‖u_i − Σ_k W_ik z_k‖²  ⇔  (Wᵀ M W) z* = Wᵀ M u
+// (the same K by K system for x, y and z). The gap between a simulation's
+// error and the floor's is dynamics or integration error; the floor is basis
+// error. Also: rel_err split by body region, so a good average cannot hide a
+// rigid limb.
+#include <vector>
+
+#include <Eigen/Sparse>
+
+#include "sflsh/core/types.hpp"
+
+namespace sflsh {
+
+/// Projection of nodal displacements onto span(W ⊗ I₃) with the mass metric.
+class SubspaceProjector {
+ public:
+  /// `W` #N by #K basis weights, `mass` #N non-negative nodal masses (kg; 0
+  /// excludes a node, e.g. a Dirichlet node). Fails if a column of W has no
+  /// weight on a node with mass or Wᵀ M W is singular.
+  SubspaceProjector(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W, const VecX& mass);
+  /// #K by 3 reduced coordinates z* of the nodal displacement `u` (#N by 3, m).
+  MatX coordinates(const Points& u) const;
+  /// #N by 3 best approximation W z* of `u` (m).
+  Points project(const Points& u) const;
+
+ private:
+  Eigen::SparseMatrix<double, Eigen::RowMajor> W_;
+  VecX mass_;
+  Eigen::LDLT<MatX> gram_;  // Wᵀ M W
+};
+
+/// Relative error per region: for each r in [0, num_regions),
+///   sqrt(Σ_f Σ_{v: region[v] = r} ‖u_f(v) − ref_f(v)‖² / Σ_f Σ_{v: region[v] = r} ‖ref_f(v)‖²)
+/// over frames f (the shorter of the two sequences) and points v with
+/// `region[v]` = r (−1: in no region). A region with no points or zero
+/// reference gives NaN. `u`, `ref`: per frame #V by 3; `region` #V labels.
+std::vector<double> region_rel_errors(const std::vector<Points>& u, const std::vector<Points>& ref,
+                                      const VecXi& region, int num_regions);
+
+}  // namespace sflsh

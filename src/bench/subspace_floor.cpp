@@ -1,0 +1,60 @@
+#include "sflsh/bench/subspace_floor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sflsh/core/error.hpp"
+
+namespace sflsh {
+
+SubspaceProjector::SubspaceProjector(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W, const VecX& mass)
+    : W_(W), mass_(mass) {
+  require(mass.size() == W.rows(), "subspace floor: ", mass.size(), " nodal masses for a basis of ", W.rows(),
+          " rows");
+  require(mass.allFinite() && (mass.size() == 0 || mass.minCoeff() >= 0.0),
+          "subspace floor: nodal masses must be finite and non-negative");
+  const Eigen::SparseMatrix<double> MW = mass.asDiagonal() * W;
+  const MatX G = MatX(Eigen::SparseMatrix<double>(W.transpose()) * MW);
+  for (Eigen::Index k = 0; k < G.rows(); ++k)
+    require(G(k, k) > 0.0, "subspace floor: basis column ", k, " has no weight on a node with mass");
+  gram_.compute(G);
+  require(gram_.info() == Eigen::Success && gram_.isPositive() &&
+              gram_.vectorD().minCoeff() > 1e-14 * gram_.vectorD().maxCoeff(),
+          "subspace floor: W^T M W is singular (linearly dependent basis columns)");
+}
+
+MatX SubspaceProjector::coordinates(const Points& u) const {
+  require(u.rows() == W_.rows() && u.cols() == 3, "subspace floor: displacement is ", u.rows(), " by ", u.cols(),
+          ", expected ", W_.rows(), " by 3");
+  const MatX rhs = W_.transpose() * (mass_.asDiagonal() * MatX(u));
+  return gram_.solve(rhs);
+}
+
+Points SubspaceProjector::project(const Points& u) const { return W_ * coordinates(u); }
+
+std::vector<double> region_rel_errors(const std::vector<Points>& u, const std::vector<Points>& ref,
+                                      const VecXi& region, int num_regions) {
+  require(num_regions >= 0, "region errors: negative region count");
+  std::vector<double> diff2(size_t(num_regions), 0.0), ref2(size_t(num_regions), 0.0);
+  std::vector<long> count(size_t(num_regions), 0);
+  const size_t F = std::min(u.size(), ref.size());
+  for (size_t f = 0; f < F; ++f) {
+    require(u[f].rows() == region.size() && ref[f].rows() == region.size(), "region errors: frame ", f, " has ",
+            u[f].rows(), " and ", ref[f].rows(), " points, expected ", region.size(), " (one region label each)");
+    for (Eigen::Index v = 0; v < region.size(); ++v) {
+      const int r = region[v];
+      if (r < 0) continue;
+      require(r < num_regions, "region errors: point ", v, " has region ", r, ", expected < ", num_regions);
+      diff2[size_t(r)] += (u[f].row(v) - ref[f].row(v)).squaredNorm();
+      ref2[size_t(r)] += ref[f].row(v).squaredNorm();
+      ++count[size_t(r)];
+    }
+  }
+  std::vector<double> out(size_t(num_regions), std::numeric_limits<double>::quiet_NaN());
+  for (int r = 0; r < num_regions; ++r)
+    if (count[size_t(r)] > 0 && ref2[size_t(r)] > 0.0) out[size_t(r)] = std::sqrt(diff2[size_t(r)] / ref2[size_t(r)]);
+  return out;
+}
+
+}  // namespace sflsh
