@@ -54,7 +54,7 @@ TEST(Tracking, ForceLimitedRootSpringIsHuber) {
   StepContext ctx = test::skeleton_context(a, test::bones_config(std::vector<Isometry>(24, Isometry::Identity())));
   for (double off : {0.05, 0.004}) {
     std::vector<Isometry> G(24, Isometry::Identity());
-    for (Isometry& g : G) g.translation() = Vec3(0, 0.6, 0.8) * off;  // |shift| = off
+    for (Isometry& g : G) g.translation() = Vec3(0.6, 0, 0.8) * off;  // horizontal, |shift| = off
     const Configuration q = test::bones_config(G);
     const double expected = off > 0.01 ? 100.0 * (off - 0.005) : 0.5 * 1e4 * off * off;
     EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), expected, 1e-12);
@@ -65,6 +65,15 @@ TEST(Tracking, ForceLimitedRootSpringIsHuber) {
     EXPECT_NEAR(force, off > 0.01 ? 100.0 : 1e4 * off, 1e-9);
     if (off < 0.01) EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), plain.evaluate(ctx, q, nullptr, nullptr), 1e-15);
   }
+  // Along gravity the spring is not limited (the motion carries the body's
+  // weight): 5 cm up costs ½ k |r|² = 12.5 J with or without the limit.
+  std::vector<Isometry> G(24, Isometry::Identity());
+  for (Isometry& g : G) g.translation() = Vec3(0, 0.05, 0);
+  const Configuration q = test::bones_config(G);
+  EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), 12.5, 1e-12);
+  VecX g = VecX::Zero(ctx.layout.size());
+  capped.evaluate(ctx, q, &g, nullptr);
+  EXPECT_LT((g - test::fd_gradient(capped, ctx, q)).norm(), 1e-6 * g.norm());
 }
 
 TEST(Tracking, DerivativesMatchFiniteDifferences) {

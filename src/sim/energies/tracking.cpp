@@ -54,19 +54,23 @@ void Tracking::residuals(const StepContext& ctx, const Configuration& q, std::ve
 double Tracking::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   double E = BoneLeastSquaresTerm::compute(ctx, q, grad, hess);
   if (k_pos_ == 0 || force_limit_ == 0) return E;
-  // The Huber root spring (header comment).
+  // The Huber root spring on the horizontal part of r, a plain spring along
+  // gravity (header comment).
   const Vec3 root = joints_rest_.row(0).transpose();
   const Vec3 x = q.bones[0] * root;
   const Vec3 r = x - (root + ctx.target_pose.translation);
-  const double n = r.norm(), d = force_limit_ / k_pos_;
+  const Vec3 up = ctx.gravity.squaredNorm() > 0 ? Vec3(ctx.gravity.normalized()) : Vec3::Zero();
+  const Mat3 V = up * up.transpose();  // projector on the vertical
+  const Vec3 rv = V * r, rh = r - rv;
+  const double n = rh.norm(), d = force_limit_ / k_pos_;
   const bool inner = n <= d;
-  E += inner ? 0.5 * k_pos_ * n * n : force_limit_ * (n - 0.5 * d);
+  E += 0.5 * k_pos_ * rv.squaredNorm() + (inner ? 0.5 * k_pos_ * n * n : force_limit_ * (n - 0.5 * d));
   if (!ctx.layout.bones_dynamic) return E;
   const Mat36 J = point_jacobian(x);
-  const double w = inner ? k_pos_ : force_limit_ / n;  // ∂E/∂r = w r
+  const double w = inner ? k_pos_ : force_limit_ / n;  // ∂E/∂r_h = w r_h
   const int o = ctx.layout.bone_offset(0);
-  if (grad) grad->segment<6>(o) += J.transpose() * (w * r);
-  if (hess) hess->block<6, 6>(o, o) += w * J.transpose() * J;
+  if (grad) grad->segment<6>(o) += J.transpose() * (k_pos_ * rv + w * rh);
+  if (hess) hess->block<6, 6>(o, o) += J.transpose() * (k_pos_ * V + w * (Mat3::Identity() - V)) * J;
   return E;
 }
 

@@ -13,12 +13,14 @@
 // inertia so every joint tracks with the same frequency f (a constant target
 // acceleration a is then followed with a lag of a/(2π f)²).
 //
-// Force limit (scenes with contact): with position_force_limit F > 0 the root
-// position spring becomes a Huber spring, ½ k|r|² for |r| ≤ d = F/k and
-// F (|r| − d/2) beyond, so the motion pulls the body along its path with at
-// most F newtons: a body walking into another is stopped by contact instead
-// of being pushed through it by an unbounded spring. Hessian beyond d: the
-// secant (F/|r|) JᵀJ (PSD).
+// Force limit (scenes with contact): with position_force_limit F > 0 the
+// horizontal part r_h of the root position residual (perpendicular to
+// ctx.gravity; all of r without gravity) gets a Huber spring, ½ k|r_h|² for
+// |r_h| ≤ d = F/k and F (|r_h| − d/2) beyond, so the motion pulls the body
+// along its path with at most F newtons: a body walking into another is
+// stopped by contact instead of being pushed through it by an unbounded
+// spring. The vertical part keeps the plain spring (the motion still carries
+// the body's weight). Hessian beyond d: the secant (F/|r_h|) on the horizontal (PSD).
 #include <vector>
 
 #include "sflsh/sim/energies/bone_residual.hpp"
