@@ -5,7 +5,8 @@
 # PLY, glTF) with its joints, renders a picture of it, precomputes the default
 # avatar (the template stage is cached in ~/.cache/sflsh), simulates the
 # built-in `jump` motion and writes the result cache, a PC2 point cache and a
-# picture of the soft-tissue displacement.
+# picture of the soft-tissue displacement, then runs a contact scene (a ball
+# thrown at the belly) and renders it.
 # Outputs go to out/demo/ (or $SFLSH_DEMO_OUT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -46,8 +47,15 @@ echo "== simulate builtin:jump for 3 s"
   --export "$OUT/jump.pc2" --render "$OUT/jump.png"
 
 echo
+echo "== a scene with contact: a ball thrown at the belly (apps/scenes/ball_at_belly.yaml)"
+cp apps/scenes/ball_at_belly.yaml "$OUT/"   # its avatar is the avatar.h5 next to it
+"$SFLSH" simulate "$OUT/ball_at_belly.yaml" --out "$OUT/ball_at_belly.h5" --export "$OUT/ball_at_belly.glb" \
+  --render "$OUT/ball_at_belly.png"
+
+echo
 echo "Done. Outputs in $(cd "$OUT" && pwd):"
 ls -1 "$OUT" | sed 's/^/  /'
 echo "Open the .obj/.ply/.glb files in Blender, MeshLab or any glTF viewer; body.png is the body,"
 echo "jump.png the simulation (skin coloured by soft displacement), jump.h5 the result cache,"
-echo "jump.pc2 + jump_rest.obj the animation for Blender (README: 'Opening results in Blender')."
+echo "jump.pc2 + jump_rest.obj the animation for Blender (README: 'Opening results in Blender');"
+echo "ball_at_belly.png/.glb the contact scene (the ball is a separate node in the glTF)."
