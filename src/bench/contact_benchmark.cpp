@@ -247,6 +247,7 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
       r.force_full_n = ref.peak_force;
       r.force_reduced_n = with.peak_force;
       r.active_samples = with.max_active;
+      r.active_samples_full = ref.max_active;
       r.us_per_sample_iter = with.sample_iterations > 0 ? 1e3 * with.contact_ms / with.sample_iterations : 0;
       r.ms_contact = median_when(with.ms, with.contact);
       r.ms_no_contact = median_when(without.ms, with.contact);
@@ -280,13 +281,13 @@ void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std
     std::ofstream f(out.temp_path());
     if (!f) fail(path, ": cannot write");
     f << "scene,handles,dt,steps,rel_err,dent_full_mm,dent_reduced_mm,dent_ratio,force_full_n,force_reduced_n,"
-         "active_samples,us_per_sample_iter,ms_contact,ms_no_contact,step_ratio,ms_full\n";
+         "active_samples,active_samples_full,us_per_sample_iter,ms_contact,ms_no_contact,step_ratio,ms_full\n";
     char buf[512];
     for (const auto& r : rows) {
-      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%d,%.4g,%.4g,%.4g,%.4g,%.4g\n",
+      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g\n",
                     r.scene.c_str(), r.handles, r.dt, r.steps, r.rel_err, r.dent_full_mm, r.dent_reduced_mm,
-                    r.dent_ratio, r.force_full_n, r.force_reduced_n, r.active_samples, r.us_per_sample_iter,
-                    r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
+                    r.dent_ratio, r.force_full_n, r.force_reduced_n, r.active_samples, r.active_samples_full,
+                    r.us_per_sample_iter, r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
       f << buf;
     }
     if (!f) fail(path, ": write failed");
@@ -301,16 +302,16 @@ void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, cons
     std::ofstream f(out.temp_path());
     if (!f) fail(path, ": cannot write");
     f << heading << "\n\n| scene | K | dt (s) | rel_err | dent full (mm) | dent reduced (mm) | dent ratio | peak force "
-                    "full / reduced (N) | active samples | µs / sample / iter | ms/step contact | ms/step no contact "
+                    "full / reduced (N) | active samples full / reduced | µs / sample / iter | ms/step contact | ms/step no contact "
                     "| ratio | full FEM ms/step |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     char buf[512];
     for (const auto& r : rows) {
       std::snprintf(buf, sizeof buf,
-                    "| %s | %d | 1/%.0f | %.3f | %.2f | %.2f | %.3f | %.1f / %.1f | %d | %.3f | %.3g | %.3g | %.2f | "
+                    "| %s | %d | 1/%.0f | %.3f | %.2f | %.2f | %.3f | %.1f / %.1f | %d / %d | %.3f | %.3g | %.3g | %.2f | "
                     "%.3g |\n",
                     r.scene.c_str(), r.handles, 1.0 / r.dt, r.rel_err, r.dent_full_mm, r.dent_reduced_mm, r.dent_ratio,
-                    r.force_full_n, r.force_reduced_n, r.active_samples, r.us_per_sample_iter, r.ms_contact,
-                    r.ms_no_contact, r.step_ratio, r.ms_full);
+                    r.force_full_n, r.force_reduced_n, r.active_samples_full, r.active_samples, r.us_per_sample_iter,
+                    r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
       f << buf;
     }
     if (!f) fail(path, ": write failed");

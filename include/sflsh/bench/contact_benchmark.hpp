@@ -65,7 +65,8 @@ struct ContactBenchRow {
   double rel_err = 0;
   double dent_full_mm = 0, dent_reduced_mm = 0, dent_ratio = 0;
   double force_full_n = 0, force_reduced_n = 0;  ///< peak |contact force| over the steps (N)
-  int active_samples = 0;        ///< reduced: largest number of penetrating samples in a step
+  int active_samples = 0;        ///< reduced: largest number of penetrating samples at the end of a step
+  int active_samples_full = 0;   ///< the same for the full-FEM reference
   double us_per_sample_iter = 0; ///< µs in the reduced contact term per active sample per Newton iteration
   double ms_contact = 0, ms_no_contact = 0, step_ratio = 0;  ///< reduced step medians (steps with contact)
   double ms_full = 0;            ///< full-FEM median step time (steps with contact)
@@ -81,7 +82,7 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
 std::vector<ContactBenchRow> run_contact_benchmark(const ContactBenchOptions& options);
 
 /// CSV with the header scene,handles,dt,steps,rel_err,dent_full_mm,dent_reduced_mm,
-/// dent_ratio,force_full_n,force_reduced_n,active_samples,us_per_sample_iter,
+/// dent_ratio,force_full_n,force_reduced_n,active_samples,active_samples_full,us_per_sample_iter,
 /// ms_contact,ms_no_contact,step_ratio,ms_full (written as PATH.partial, then renamed).
 void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std::string& path);
 /// The rows as a Markdown table, `heading` (Markdown) above it.
