@@ -47,6 +47,7 @@ struct Trace {
   double sample_iterations = 0;     // Σ active samples × Newton iterations over contact steps
   int max_active = 0;
   double peak_force = 0;            // N
+  int unconverged = 0;              // full FEM: steps that stopped before the gradient tolerance
 };
 
 bool simulated_vertex(const Avatar& a, int v) {
@@ -124,11 +125,15 @@ Trace run_full(std::shared_ptr<const Avatar> avatar, const Scene& sc, const Site
     const FullFemContact& c = rep.contacts.at(0);
     tr.contact.push_back(c.active_samples > 0);
     tr.contact_ms += rep.ms_contact;
+    if (!rep.converged) ++tr.unconverged;
     tr.max_active = std::max(tr.max_active, c.active_samples);
     tr.peak_force = std::max(tr.peak_force, c.force.norm());
     p.update(i);
   }
   p.finish();
+  if (tr.unconverged > 0)
+    log_info("bench-contact: full FEM, " + sc.name + ": " + std::to_string(tr.unconverged) + " of " +
+             std::to_string(sc.steps) + " steps stopped before the gradient tolerance");
   return tr;
 }
 
