@@ -86,6 +86,9 @@ TEST(FullFemContact, SphereEnergyGradientAndGaussNewtonHessian) {
     }
     return E;
   };
+  const Points skin = with.skin_points(u);
+  for (int v = 0; v < a->surface_rest.rows(); ++v)
+    EXPECT_LT((skin.row(v).transpose() - skin_world(*a, v, u, bones)).norm(), 1e-14);
   VecX g1, g0;
   Eigen::SparseMatrix<double> H1, H0;
   const double E = with.energy(u, &g1, &H1) - without.energy(u, &g0, &H0);
