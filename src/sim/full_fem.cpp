@@ -1,5 +1,6 @@
 #include "sflsh/sim/full_fem.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -128,6 +129,9 @@ FullFem::FullFem(std::shared_ptr<const Avatar> avatar, FullFemOptions options)
       for (int c = 0; c < 3; ++c) node_slot_[9 * f + 3 * r + c] = slot(3 * f + r, 3 * f + c);
 
   surface_ = PosedPoints::at_surface(a);
+  require(a.surface_tet.size() == a.surface_rest.rows() && a.surface_bary.rows() == a.surface_rest.rows() &&
+              a.surface_weights.rows() == a.surface_rest.rows(),
+          "FullFem: surface_tet / surface_bary / surface_weights do not have #V = ", a.surface_rest.rows(), " rows");
   reset(std::vector<Isometry>(24, Isometry::Identity()));
 }
 
@@ -156,6 +160,98 @@ void FullFem::reset(const std::vector<Isometry>& bones) {
 
 double FullFem::energy(const Points& u) const {
   return const_cast<FullFem*>(this)->evaluate(u, nullptr, false);
+}
+
+double FullFem::energy(const Points& u, VecX* gradient, Eigen::SparseMatrix<double>* hessian) const {
+  require(u.rows() == avatar_->tet.num_nodes() && u.cols() == 3, "FullFem::energy: u is ", u.rows(), " by ", u.cols(),
+          ", expected #N = ", avatar_->tet.num_nodes(), " by 3");
+  const double E = const_cast<FullFem*>(this)->evaluate(u, gradient, hessian != nullptr);
+  if (hessian) *hessian = chol_->H.selfadjointView<Eigen::Lower>();
+  return E;
+}
+
+int FullFem::add_obstacle(FullFemObstacle obstacle) {
+  require(obstacle.field != nullptr, "FullFem::add_obstacle: obstacle '", obstacle.name, "' has no field");
+  require(std::isfinite(obstacle.stiffness) && obstacle.stiffness >= 0, "FullFem::add_obstacle: obstacle '",
+          obstacle.name, "' has stiffness ", obstacle.stiffness, " N/m, expected >= 0");
+  obstacles_.push_back(std::move(obstacle));
+  obstacle_poses_.push_back(Isometry::Identity());
+  return int(obstacles_.size()) - 1;
+}
+
+Vec3 FullFem::skin_point(int v, const Points& u) const {
+  const Avatar& a = *avatar_;
+  Vec3 y = a.surface_rest.row(v).transpose();
+  for (int c = 0; c < 4; ++c) y += a.surface_bary(v, c) * u.row(a.tet.elements(a.surface_tet[v], c)).transpose();
+  Vec3 x = Vec3::Zero();
+  for (int j = 0; j < a.surface_weights.cols(); ++j)
+    if (a.surface_weights(v, j) != 0.0) x += a.surface_weights(v, j) * (bones_[j] * y);
+  return x;
+}
+
+Points FullFem::skin_points(const Points& u) const {
+  Points x(avatar_->surface_rest.rows(), 3);
+  for (int v = 0; v < x.rows(); ++v) x.row(v) = skin_point(v, u).transpose();
+  return x;
+}
+
+double FullFem::evaluate_contact(const Points& u, VecX* grad, bool hessian,
+                                 std::vector<FullFemContact>* report) const {
+  if (obstacles_.empty()) return 0;
+  Timer timer;
+  const Avatar& a = *avatar_;
+  require(skin_A_.size() == size_t(a.surface_rest.rows()), "FullFem: contact evaluated before the first step");
+  double* values = chol_->H.valuePtr();
+  double E = 0;
+  for (size_t o = 0; o < obstacles_.size(); ++o) {
+    const FullFemObstacle& ob = obstacles_[o];
+    const Isometry& T = obstacle_poses_[o];
+    const Isometry T_inv = T.inverse();
+    const geometry::Aabb box = ob.field->bounds().transformed(T);
+    const bool bounded = !box.is_unbounded();
+    const double k = ob.stiffness;
+    FullFemContact rep;
+    rep.name = ob.name;
+    for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
+      const Vec3 x = skin_point(v, u);
+      if (bounded && !box.contains(x)) continue;  // outside the solid's box: φ ≥ 0
+      const geometry::SdfSample s = ob.field->evaluate(T_inv * x);
+      const double d = s.distance;
+      if (!(d < 0)) continue;
+      E += 0.5 * k * d * d;
+      const Vec3 n = T.linear() * s.gradient;  // ∂φ/∂x, world
+      if (report) {
+        rep.force -= k * d * n;
+        ++rep.active_samples;
+        rep.max_penetration = std::max(rep.max_penetration, -d);
+      }
+      if (!grad && !hessian) continue;
+      const Vec3 g = skin_A_[v].transpose() * n;  // ∂φ/∂y, y = x̄ + u in the unposed space
+      const int t = a.surface_tet[v];
+      if (grad)
+        for (int c = 0; c < 4; ++c) {
+          const int f = node_free_[a.tet.elements(t, c)];
+          if (f >= 0 && a.surface_bary(v, c) != 0.0) grad->segment<3>(3 * f) += k * d * a.surface_bary(v, c) * g;
+        }
+      if (hessian) {
+        const Mat3 G = k * g * g.transpose();
+        const int* slots = &tet_slot_[size_t(t) * 144];
+        for (int c = 0; c < 4; ++c)
+          for (int e = 0; e < 4; ++e) {
+            const double be = a.surface_bary(v, c) * a.surface_bary(v, e);
+            if (be == 0.0) continue;
+            for (int i = 0; i < 3; ++i)
+              for (int l = 0; l < 3; ++l) {
+                const int slot = slots[12 * (3 * c + i) + 3 * e + l];
+                if (slot >= 0) values[slot] += be * G(i, l);
+              }
+          }
+      }
+    }
+    if (report) report->push_back(rep);
+  }
+  ms_contact_ += timer.ms();
+  return E;
 }
 
 double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
@@ -212,20 +308,28 @@ double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
         }
     }
   }
-  return E;
+  return E + evaluate_contact(u, grad, hessian, nullptr);
 }
 
-FullFemReport FullFem::step(const std::vector<Isometry>& bones_next) {
+FullFemReport FullFem::step(const std::vector<Isometry>& bones_next, const std::vector<Isometry>& obstacle_poses) {
   require(bones_next.size() == 24, "FullFem::step: ", bones_next.size(), " bones, expected 24");
+  require(obstacle_poses.size() == obstacles_.size(), "FullFem::step: ", obstacle_poses.size(),
+          " obstacle poses, expected one per obstacle (", obstacles_.size(), ")");
   Timer total;
   FullFemReport rep;
   const Avatar& a = *avatar_;
   x_pred_ = 2.0 * x_now_ - x_prev_;
   bones_ = bones_next;
+  obstacle_poses_ = obstacle_poses;
+  ms_contact_ = 0;
   A_.assign(a.tet.num_nodes(), Mat3::Zero());
   for (int n = 0; n < a.tet.num_nodes(); ++n)
     for (int j = 0; j < a.node_weights.cols(); ++j)
       if (a.node_weights(n, j) != 0.0) A_[n] += a.node_weights(n, j) * bones_[j].linear();
+  skin_A_.assign(a.surface_rest.rows(), Mat3::Zero());
+  for (size_t v = 0; v < skin_A_.size(); ++v)
+    for (int j = 0; j < a.surface_weights.cols(); ++j)
+      if (a.surface_weights(v, j) != 0.0) skin_A_[v] += a.surface_weights(v, j) * bones_[j].linear();
 
   VecX g;
   for (int it = 0; it < options_.max_iterations; ++it) {
@@ -281,6 +385,8 @@ FullFemReport FullFem::step(const std::vector<Isometry>& bones_next) {
       break;
     }
   }
+  evaluate_contact(u_, nullptr, false, &rep.contacts);
+  rep.ms_contact = ms_contact_;
   x_prev_ = x_now_;
   x_now_ = world_nodes(u_, bones_);
   time_ += options_.h;

@@ -1,0 +1,92 @@
+#pragma once
+// `sflsh bench-contact` (issue 10): the reduced model against the full-FEM
+// reference under rigid contact, i.e. how well K handles represent a local
+// dent. Two scenes on one avatar shape with kinematic bones in the rest pose
+// and gravity off (so the soft displacement is the contact response alone):
+//
+//   pressed: a kinematic sphere (radius 8 cm) starts 1 cm in front of the belly,
+//            moves 4 cm along the inward normal over 0.5 s (3 cm deep) and is
+//            held 0.5 s; time step 1/60 s.
+//   impact:  a kinematic ball (radius 11 cm) starts 2 cm in front, moves in at
+//            3 m/s until 3 cm deep, then leaves at 3 m/s; 0.3 s in all, time
+//            step 1/240 s (the contact lasts ~30 ms: 7 steps).
+//
+// The belly point p is the front-most skin vertex (largest z; the body faces
+// +z) with |x| < 5 cm between the pelvis and spine2 joint heights whose tet
+// has a Simulated node; the inward normal is −z. Every skin vertex is a
+// contact sample (reduced: skin_contact_samples; full FEM: FullFem obstacles),
+// with the same stiffness.
+//
+// Per scene and handle count K, compared at every step:
+//   rel_err     = ‖u − u_ref‖ / ‖u_ref‖ over skin vertices and steps (u: soft
+//                 displacement of the skin, unposed = world here; vertices
+//                 outside the simulated region have u = 0 in both);
+//   dent        = max over steps and over skin vertices within 1.5 r of p of
+//                 the inward displacement −u·n (mm); dent_ratio = reduced / full;
+//   us_per_sample_iter = time in the reduced contact term / Σ_steps (active
+//                 samples × Newton iterations), over the steps with contact;
+//   step_ratio  = median reduced step time over the steps with contact /
+//                 median step time of the same steps of the scene without the object.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sflsh/asset/avatar.hpp"
+#include "sflsh/precompute/precompute.hpp"
+
+namespace sflsh {
+
+/// Scene and solver settings of the contact benchmark.
+struct ContactBenchSettings {
+  bool quick = false;            ///< shorter scenes (pressed 0.25 s + 0.1 s hold; impact 0.1 s)
+  double stiffness = 2.0e4;      ///< N/m per skin sample (SdfContactOptions' default), both solvers
+  int newton_iters = 1;          ///< reduced solver's Newton iterations per step (1: the default simulator)
+  double pressed_radius = 0.08;  ///< m
+  double pressed_depth = 0.03;   ///< m, final depth below the undeformed belly
+  double impact_radius = 0.11;   ///< m
+  double impact_speed = 3.0;     ///< m/s
+  double impact_depth = 0.03;    ///< m, deepest kinematic penetration of the ball
+  double pressed_dt = 1.0 / 60.0, impact_dt = 1.0 / 240.0;  ///< s
+};
+
+struct ContactBenchOptions {
+  ContactBenchSettings settings;
+  std::string model = "procedural";
+  VecX betas;
+  std::vector<int> handle_counts;  ///< empty: {32, 64, 128} ({32} with settings.quick)
+  PrecomputeOptions precompute;    ///< template/shape options (cache dir, ...)
+};
+
+struct ContactBenchRow {
+  std::string scene;             ///< pressed | impact
+  int handles = 0;               ///< K
+  double dt = 0;                 ///< s
+  int steps = 0;
+  double rel_err = 0;
+  double dent_full_mm = 0, dent_reduced_mm = 0, dent_ratio = 0;
+  double force_full_n = 0, force_reduced_n = 0;  ///< peak |contact force| over the steps (N)
+  int active_samples = 0;        ///< reduced: largest number of penetrating samples at the end of a step
+  int active_samples_full = 0;   ///< the same for the full-FEM reference
+  double us_per_sample_iter = 0; ///< µs in the reduced contact term per active sample per Newton iteration
+  double ms_contact = 0, ms_no_contact = 0, step_ratio = 0;  ///< reduced step medians (steps with contact)
+  double ms_full = 0;            ///< full-FEM median step time (steps with contact)
+};
+
+/// Runs both scenes on `avatars` (one per handle count; they must share the
+/// tet mesh, skin and skeleton, as precompute_shape at several K gives) and
+/// returns one row per scene and avatar. Progress on stderr.
+std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_ptr<const Avatar>>& avatars,
+                                                const ContactBenchSettings& settings);
+
+/// Precomputes the avatar at every handle count and runs run_contact_scenes.
+std::vector<ContactBenchRow> run_contact_benchmark(const ContactBenchOptions& options);
+
+/// CSV with the header scene,handles,dt,steps,rel_err,dent_full_mm,dent_reduced_mm,
+/// dent_ratio,force_full_n,force_reduced_n,active_samples,active_samples_full,us_per_sample_iter,
+/// ms_contact,ms_no_contact,step_ratio,ms_full (written as PATH.partial, then renamed).
+void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std::string& path);
+/// The rows as a Markdown table, `heading` (Markdown) above it.
+void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
+                                  const std::string& heading);
+
+}  // namespace sflsh

@@ -1,0 +1,327 @@
+#include "sflsh/bench/contact_benchmark.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/percentile.hpp"
+#include "sflsh/core/progress.hpp"
+#include "sflsh/geometry/primitive_sdfs.hpp"
+#include "sflsh/io/atomic_output.hpp"
+#include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/soft_tissue_terms.hpp"
+
+namespace sflsh {
+namespace {
+
+const char* const kObject = "ball";
+
+/// The belly contact point and the skin vertices near it.
+struct Site {
+  Vec3 point = Vec3::Zero();          ///< unposed = world (rest pose), m
+  Vec3 outward = Vec3::UnitZ();       ///< the body faces +z
+};
+
+/// A kinematic sphere moving along the belly normal: gap(t) is the signed
+/// distance (m) of its surface from the belly point along the outward normal.
+struct Scene {
+  std::string name;
+  double radius = 0, dt = 0;
+  int steps = 0;
+  std::function<double(double)> gap;
+  Vec3 centre(const Site& s, double t) const { return s.point + s.outward * (radius + gap(t)); }
+};
+
+/// One run: the skin's soft displacement and what the step reported, per step.
+struct Trace {
+  std::vector<Points> u;            // #V by 3 per step (m)
+  std::vector<double> ms;           // step time
+  std::vector<bool> contact;        // some sample penetrates at the end of the step
+  double contact_ms = 0;            // time in the contact term (reduced) or contact evaluation (full)
+  double sample_iterations = 0;     // Σ active samples × Newton iterations over contact steps
+  int max_active = 0;
+  double peak_force = 0;            // N
+  int unconverged = 0;              // full FEM: steps that stopped before the gradient tolerance
+};
+
+bool simulated_vertex(const Avatar& a, int v) {
+  if (a.node_role.size() == 0) return true;
+  for (int c = 0; c < 4; ++c)
+    if (a.node_role[a.tet.elements(a.surface_tet[v], c)] == int(NodeRole::Simulated)) return true;
+  return false;
+}
+
+Site belly_site(const Avatar& a) {
+  require(a.joints_rest.rows() == 24, "bench-contact: the avatar has ", a.joints_rest.rows(), " joints, expected 24");
+  const double y0 = a.joints_rest(0, 1), y1 = a.joints_rest(6, 1);
+  const Vec3 mid(0, 0.5 * (y0 + y1), 0);
+  int best = -1;
+  double best_z = 0, best_off = 0;
+  for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
+    const Vec3 x = a.surface_rest.row(v).transpose();
+    if (std::abs(x.x()) >= 0.05 || x.y() < std::min(y0, y1) || x.y() > std::max(y0, y1) || !simulated_vertex(a, v))
+      continue;
+    // Front-most; among vertices within 1 mm of that, the nearest to the mid line.
+    const double off = std::hypot(x.x(), x.y() - mid.y());
+    if (best < 0 || x.z() > best_z + 1e-3 || (x.z() > best_z - 1e-3 && off < best_off)) {
+      best = v;
+      best_z = x.z();
+      best_off = off;
+    }
+  }
+  require(best >= 0, "bench-contact: no simulated skin vertex with |x| < 5 cm between the pelvis and spine2 heights");
+  Site s;
+  s.point = a.surface_rest.row(best).transpose();
+  return s;
+}
+
+std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
+  require(o.pressed_radius > 0 && o.impact_radius > 0 && o.impact_speed > 0 && o.pressed_depth > 0 &&
+              o.impact_depth > 0 && o.pressed_dt > 0 && o.impact_dt > 0 && o.stiffness > 0 && o.newton_iters >= 1,
+          "bench-contact: radii, depths, speed, time steps, stiffness and Newton iterations must be positive");
+  std::vector<Scene> scenes;
+  {
+    const double ramp = o.quick ? 0.25 : 0.5, total = o.quick ? 0.35 : 1.0, start = 0.01, depth = o.pressed_depth;
+    Scene s{"pressed", o.pressed_radius, o.pressed_dt, int(std::lround(total / o.pressed_dt)), nullptr};
+    s.gap = [=](double t) { return start - (start + depth) * std::min(std::max(t, 0.0) / ramp, 1.0); };
+    scenes.push_back(s);
+  }
+  {
+    const double start = 0.02, depth = o.impact_depth, v = o.impact_speed, turn = (start + depth) / v;
+    const double total = o.quick ? 0.1 : 0.3;
+    Scene s{"impact", o.impact_radius, o.impact_dt, int(std::lround(total / o.impact_dt)), nullptr};
+    s.gap = [=](double t) { return t < turn ? start - v * t : -depth + v * (t - turn); };
+    scenes.push_back(s);
+  }
+  return scenes;
+}
+
+Isometry translation(const Vec3& c) {
+  Isometry T = Isometry::Identity();
+  T.translation() = c;
+  return T;
+}
+
+Trace run_full(std::shared_ptr<const Avatar> avatar, const Scene& sc, const Site& site, const ContactBenchSettings& o) {
+  FullFemOptions fo;
+  fo.h = sc.dt;
+  fo.gravity = Vec3::Zero();
+  fo.gradient_tolerance = 1e-6;  // as `sflsh bench`'s reference: far below the errors reported
+  FullFem fem(avatar, fo);
+  fem.add_obstacle({kObject, std::make_shared<geometry::SphereSdf>(sc.radius), o.stiffness});
+  Trace tr;
+  Progress p("bench-contact: full FEM, " + sc.name, sc.steps);
+  for (int i = 1; i <= sc.steps; ++i) {
+    const FullFemReport rep = fem.step(identity_bones(), {translation(sc.centre(site, i * sc.dt))});
+    require(fem.displacement().allFinite(), "bench-contact: the full-FEM ", sc.name, " run became non-finite at step ", i);
+    tr.u.push_back(fem.soft_displacement());
+    tr.ms.push_back(rep.ms_total);
+    const FullFemContact& c = rep.contacts.at(0);
+    tr.contact.push_back(c.active_samples > 0);
+    tr.contact_ms += rep.ms_contact;
+    if (!rep.converged) ++tr.unconverged;
+    tr.max_active = std::max(tr.max_active, c.active_samples);
+    tr.peak_force = std::max(tr.peak_force, c.force.norm());
+    p.update(i);
+  }
+  p.finish();
+  if (tr.unconverged > 0)
+    log_info("bench-contact: full FEM, " + sc.name + ": " + std::to_string(tr.unconverged) + " of " +
+             std::to_string(sc.steps) + " steps stopped before the gradient tolerance");
+  return tr;
+}
+
+Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const Site& site, const ContactBenchSettings& o,
+                  bool with_object) {
+  ModelOptions mo;
+  mo.h = sc.dt;
+  mo.gravity = Vec3::Zero();
+  mo.newton.iterations = o.newton_iters;
+  mo.newton.line_search = o.newton_iters > 1;
+  mo.parallel_groups = false;
+  ModelBuilder mb(mo);
+  const int body = mb.add_body({"avatar", avatar, false});
+  add_soft_tissue_terms(mb, body);
+  if (with_object) {
+    SdfContactOptions co;
+    co.stiffness = o.stiffness;
+    mb.add_term(std::make_shared<const SdfContactTerm>(kObject, skin_contact_samples(*avatar),
+                                                       std::make_shared<geometry::SphereSdf>(sc.radius),
+                                                       Isometry::Identity(), false, co),
+                {body});
+  }
+  Simulator sim(mb.build());
+  const std::string term = std::string("contact:") + kObject;
+  Trace tr;
+  Progress p("bench-contact: reduced K=" + std::to_string(avatar->num_handles()) + ", " + sc.name +
+                 (with_object ? "" : " without the ball"),
+             sc.steps);
+  StepInputs in;
+  in.bodies.push_back({identity_bones(), {}});
+  for (int i = 1; i <= sc.steps; ++i) {
+    const double t = i * sc.dt;
+    WorldFrame& f = in.frames[kObject];
+    f.pose = translation(sc.centre(site, t));
+    f.linear_velocity = (sc.centre(site, t) - sc.centre(site, t - sc.dt)) / sc.dt;
+    const StepReport rep = sim.step(in);
+    require(sim.state().z.allFinite(), "bench-contact: the reduced ", sc.name, " run became non-finite at step ", i);
+    tr.u.push_back(sim.soft_displacement());
+    tr.ms.push_back(rep.ms_total);
+    int active = 0;
+    for (const TermQuantityReport& q : rep.quantities)
+      if (q.term == term && q.name == "active_samples") active = int(q.value.at(0));
+      else if (q.term == term && q.name == "force")
+        tr.peak_force = std::max(tr.peak_force, Vec3(q.value.at(0), q.value.at(1), q.value.at(2)).norm());
+    tr.contact.push_back(active > 0);
+    tr.max_active = std::max(tr.max_active, active);
+    if (active > 0) {
+      for (const TermEnergy& e : rep.energies)
+        if (e.name == term) tr.contact_ms += e.ms;
+      tr.sample_iterations += double(active) * rep.iterations;
+    }
+    p.update(i);
+  }
+  p.finish();
+  return tr;
+}
+
+/// Median of `ms` over the steps flagged in `when` (all steps if none is).
+double median_when(const std::vector<double>& ms, const std::vector<bool>& when) {
+  std::vector<double> picked;
+  for (size_t i = 0; i < ms.size(); ++i)
+    if (when[i]) picked.push_back(ms[i]);
+  return percentile(picked.empty() ? ms : picked, 0.5);
+}
+
+/// Peak inward displacement (m) over the steps of the vertices within `reach` of the site.
+double peak_dent(const Trace& tr, const Avatar& a, const Site& site, double reach) {
+  double dent = 0;
+  for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
+    if ((a.surface_rest.row(v).transpose() - site.point).norm() > reach) continue;
+    for (const Points& u : tr.u) dent = std::max(dent, -u.row(v).dot(site.outward.transpose()));
+  }
+  return dent;
+}
+
+double relative_error(const Trace& tr, const Trace& ref) {
+  double diff2 = 0, ref2 = 0;
+  for (size_t f = 0; f < std::min(tr.u.size(), ref.u.size()); ++f) {
+    diff2 += (tr.u[f] - ref.u[f]).squaredNorm();
+    ref2 += ref.u[f].squaredNorm();
+  }
+  return ref2 > 0 ? std::sqrt(diff2 / ref2) : 0;
+}
+
+}  // namespace
+
+std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_ptr<const Avatar>>& avatars,
+                                                const ContactBenchSettings& settings) {
+  require(!avatars.empty(), "bench-contact: no avatars");
+  const Avatar& base = *avatars[0];
+  for (const auto& a : avatars)
+    require(a->tet.num_nodes() == base.tet.num_nodes() && a->tet.num_elements() == base.tet.num_elements() &&
+                a->surface_rest.rows() == base.surface_rest.rows(),
+            "bench-contact: the avatars do not share the tet mesh and skin (", a->tet.num_nodes(), " vs ",
+            base.tet.num_nodes(), " nodes)");
+  const Site site = belly_site(base);
+  log_info("bench-contact: belly point (" + std::to_string(site.point.x()) + ", " + std::to_string(site.point.y()) +
+           ", " + std::to_string(site.point.z()) + ") m");
+  std::vector<ContactBenchRow> rows;
+  for (const Scene& sc : make_scenes(settings)) {
+    const Trace ref = run_full(avatars[0], sc, site, settings);
+    const double reach = 1.5 * sc.radius;
+    const double dent_ref = peak_dent(ref, base, site, reach);
+    for (const auto& a : avatars) {
+      const Trace with = run_reduced(a, sc, site, settings, true);
+      const Trace without = run_reduced(a, sc, site, settings, false);
+      ContactBenchRow r;
+      r.scene = sc.name;
+      r.handles = a->num_handles();
+      r.dt = sc.dt;
+      r.steps = sc.steps;
+      r.rel_err = relative_error(with, ref);
+      r.dent_full_mm = 1e3 * dent_ref;
+      r.dent_reduced_mm = 1e3 * peak_dent(with, *a, site, reach);
+      r.dent_ratio = dent_ref > 0 ? r.dent_reduced_mm / r.dent_full_mm : 0;
+      r.force_full_n = ref.peak_force;
+      r.force_reduced_n = with.peak_force;
+      r.active_samples = with.max_active;
+      r.active_samples_full = ref.max_active;
+      r.us_per_sample_iter = with.sample_iterations > 0 ? 1e3 * with.contact_ms / with.sample_iterations : 0;
+      r.ms_contact = median_when(with.ms, with.contact);
+      r.ms_no_contact = median_when(without.ms, with.contact);
+      r.step_ratio = r.ms_no_contact > 0 ? r.ms_contact / r.ms_no_contact : 0;
+      r.ms_full = median_when(ref.ms, ref.contact);
+      rows.push_back(r);
+    }
+  }
+  return rows;
+}
+
+std::vector<ContactBenchRow> run_contact_benchmark(const ContactBenchOptions& in) {
+  std::vector<int> ks = in.handle_counts;
+  if (ks.empty()) ks = in.settings.quick ? std::vector<int>{32} : std::vector<int>{32, 64, 128};
+  const BodyModel model = load_body_model(in.model);
+  const TemplateVolume tv = cached_template_volume(model, in.precompute);
+  std::vector<std::shared_ptr<const Avatar>> avatars;
+  for (int K : ks) {
+    require(K >= 1, "bench-contact: handle count ", K, ", expected >= 1");
+    PrecomputeOptions po = in.precompute;
+    po.handles = K;
+    log_info("bench-contact: shape stage with K = " + std::to_string(K) + " handles");
+    avatars.push_back(std::make_shared<const Avatar>(precompute_shape(tv, model, in.betas, po)));
+  }
+  return run_contact_scenes(avatars, in.settings);
+}
+
+void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std::string& path) {
+  io::AtomicOutput out(path);
+  {
+    std::ofstream f(out.temp_path());
+    if (!f) fail(path, ": cannot write");
+    f << "scene,handles,dt,steps,rel_err,dent_full_mm,dent_reduced_mm,dent_ratio,force_full_n,force_reduced_n,"
+         "active_samples,active_samples_full,us_per_sample_iter,ms_contact,ms_no_contact,step_ratio,ms_full\n";
+    char buf[512];
+    for (const auto& r : rows) {
+      std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g\n",
+                    r.scene.c_str(), r.handles, r.dt, r.steps, r.rel_err, r.dent_full_mm, r.dent_reduced_mm,
+                    r.dent_ratio, r.force_full_n, r.force_reduced_n, r.active_samples, r.active_samples_full,
+                    r.us_per_sample_iter, r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
+      f << buf;
+    }
+    if (!f) fail(path, ": write failed");
+  }
+  out.commit();
+}
+
+void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
+                                  const std::string& heading) {
+  io::AtomicOutput out(path);
+  {
+    std::ofstream f(out.temp_path());
+    if (!f) fail(path, ": cannot write");
+    f << heading << "\n\n| scene | K | dt (s) | rel_err | dent full (mm) | dent reduced (mm) | dent ratio | peak force "
+                    "full / reduced (N) | active samples full / reduced | µs / sample / iter | ms/step contact | ms/step no contact "
+                    "| ratio | full FEM ms/step |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    char buf[512];
+    for (const auto& r : rows) {
+      std::snprintf(buf, sizeof buf,
+                    "| %s | %d | 1/%.0f | %.3f | %.2f | %.2f | %.3f | %.1f / %.1f | %d / %d | %.3f | %.3g | %.3g | %.2f | "
+                    "%.3g |\n",
+                    r.scene.c_str(), r.handles, 1.0 / r.dt, r.rel_err, r.dent_full_mm, r.dent_reduced_mm, r.dent_ratio,
+                    r.force_full_n, r.force_reduced_n, r.active_samples_full, r.active_samples, r.us_per_sample_iter,
+                    r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
+      f << buf;
+    }
+    if (!f) fail(path, ": write failed");
+  }
+  out.commit();
+}
+
+}  // namespace sflsh
