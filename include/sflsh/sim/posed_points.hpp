@@ -37,6 +37,23 @@ class PosedPoints {
   Vec3 world_point(int p, const Configuration& q) const;
   /// The bone with the largest skinning weight at point p (−1 if it has none).
   int dominant_bone(int p) const;
+  /// Point p's sparse rows: bones (index, skinning weight) and handles
+  /// (index, basis weight); pointers into this set, valid while it lives.
+  struct Rows {
+    const int* bones;
+    const double* bone_weights;
+    int num_bones;
+    const int* handles;
+    const double* handle_weights;
+    int num_handles;
+  };
+  Rows rows(int p) const {
+    return {bone_index_.data() + bone_start_[p], bone_weight_.data() + bone_start_[p],
+            bone_start_[p + 1] - bone_start_[p],  handle_index_.data() + handle_start_[p],
+            handle_weight_.data() + handle_start_[p], handle_start_[p + 1] - handle_start_[p]};
+  }
+  /// x̄ + U z of point p (m, unposed).
+  Vec3 unposed_displaced(int p, const VecX& z) const { return local(p, z); }
   /// #P by 3 unposed rest positions x̄ (m).
   const Points& unposed() const { return x_unposed_; }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <map>
 #include <tuple>
 
@@ -163,9 +164,6 @@ double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, V
   const DofLayout& L = ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
   const int ob = dynamic_ ? ctx.bound[1].layout.base : -1;
   const double k = options_.stiffness;
-  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
-  std::vector<int> cols;
-  VecX g;
   double E = 0;
   const ContactCache& cc = contact_cache(ctx, name());
   const double mu = options_.friction, eps = options_.static_slip_speed * ctx.h;
@@ -182,33 +180,75 @@ double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, V
     E += 0.5 * k * d * d;
     if (!grad && !hess) continue;
     const Vec3 n = T.linear() * s.gradient;  // ∂φ/∂x, world
-    samples_.local_jacobian(p, q, L, J, cols);
-    g.noalias() = J.transpose() * n;  // ∂φ/∂δ over the body's columns
-    Eigen::Matrix<double, 6, 1> go = Eigen::Matrix<double, 6, 1>::Zero();  // ∂φ/∂ξ_object
-    if (dynamic_) {
-      go.head<3>() = -x.cross(n);  // a point of the object moves by ω × x + v (configuration.hpp)
-      go.tail<3>() = -n;
-    }
-    const int m = int(cols.size());
-    if (grad) {
-      for (int a = 0; a < m; ++a) (*grad)[cols[a]] += k * d * g[a];
-      if (dynamic_) grad->segment<6>(ob) += k * d * go;
-    }
-    if (hess) {
-      for (int a = 0; a < m; ++a)
-        for (int c = 0; c < m; ++c) (*hess)(cols[a], cols[c]) += k * g[a] * g[c];
-      if (dynamic_) {
-        hess->block<6, 6>(ob, ob) += k * go * go.transpose();
-        for (int a = 0; a < m; ++a)
-          for (int i = 0; i < 6; ++i) {
-            const double v = k * g[a] * go[i];
-            (*hess)(cols[a], ob + i) += v;
-            (*hess)(ob + i, cols[a]) += v;
-          }
-      }
-    }
+    add_normal_derivatives(q, L, p, n, k * d, k, ob, x, grad, hess);
   }
   return E;
+}
+
+void SdfContactTerm::add_normal_derivatives(const Configuration& q, const DofLayout& L, int p, const Vec3& n,
+                                            double kd, double k, int ob, const Vec3& x, VecRef* grad,
+                                            MatRef* hess) const {
+  // ∂φ/∂δ = nᵀ J_p, by blocks (posed_points.hpp): bone j (if dynamic)
+  // (p_j × n, w_j n) with p_j = w_j G_j y; handle h: w_h Aᵀ n, A = Σ_j w_j R_j.
+  // The Gauss–Newton Hessian k (∂φ/∂δ)ᵀ(∂φ/∂δ) is written block by block
+  // (fixed-size 6x6, 6x3, 3x3), so its cost is (6 n_b + 3 n_h)² without indirection.
+  const PosedPoints::Rows r = samples_.rows(p);
+  const Vec3 y = samples_.unposed_displaced(p, q.z);
+  Mat3 A = Mat3::Zero();
+  std::array<Eigen::Matrix<double, 6, 1>, 8> gb;  // bones per point are few (≤ 4 in SMPL skinning; checked)
+  std::array<int, 8> ob_bone;
+  const int nb = L.bones_dynamic ? r.num_bones : 0;
+  require(nb <= 8, name(), ": a skin sample has ", nb, " bones, at most 8 are supported");
+  for (int e = 0; e < r.num_bones; ++e) {
+    const Isometry& G = q.bones[r.bones[e]];
+    const double w = r.bone_weights[e];
+    A += w * G.linear();
+    if (e < nb) {
+      gb[e].head<3>() = (w * (G * y)).cross(n);
+      gb[e].tail<3>() = w * n;
+      ob_bone[e] = L.bone_offset(r.bones[e]);
+    }
+  }
+  const Vec3 a = A.transpose() * n;
+  const int z0 = L.z_offset();
+  Eigen::Matrix<double, 6, 1> go = Eigen::Matrix<double, 6, 1>::Zero();  // ∂φ/∂ξ_object: a point of the object moves by ω × x + v
+  if (ob >= 0) {
+    go.head<3>() = -x.cross(n);
+    go.tail<3>() = -n;
+  }
+  if (grad) {
+    for (int i = 0; i < nb; ++i) grad->segment<6>(ob_bone[i]) += kd * gb[i];
+    for (int h = 0; h < r.num_handles; ++h) grad->segment<3>(z0 + 3 * r.handles[h]) += (kd * r.handle_weights[h]) * a;
+    if (ob >= 0) grad->segment<6>(ob) += kd * go;
+  }
+  if (!hess) return;
+  const Mat3 aa = k * a * a.transpose();
+  for (int h = 0; h < r.num_handles; ++h) {
+    const int zh = z0 + 3 * r.handles[h];
+    const double wh = r.handle_weights[h];
+    for (int l = 0; l < r.num_handles; ++l)
+      hess->block<3, 3>(zh, z0 + 3 * r.handles[l]) += (wh * r.handle_weights[l]) * aa;
+    const Vec3 ka = (k * wh) * a;
+    for (int i = 0; i < nb; ++i) {
+      const Eigen::Matrix<double, 6, 3> c = gb[i] * ka.transpose();
+      hess->block<6, 3>(ob_bone[i], zh) += c;
+      hess->block<3, 6>(zh, ob_bone[i]) += c.transpose();
+    }
+    if (ob >= 0) {
+      const Eigen::Matrix<double, 6, 3> c = go * ka.transpose();
+      hess->block<6, 3>(ob, zh) += c;
+      hess->block<3, 6>(zh, ob) += c.transpose();
+    }
+  }
+  for (int i = 0; i < nb; ++i) {
+    for (int j = 0; j < nb; ++j) hess->block<6, 6>(ob_bone[i], ob_bone[j]) += k * gb[i] * gb[j].transpose();
+    if (ob >= 0) {
+      const Eigen::Matrix<double, 6, 6> c = k * gb[i] * go.transpose();
+      hess->block<6, 6>(ob_bone[i], ob) += c;
+      hess->block<6, 6>(ob, ob_bone[i]) += c.transpose();
+    }
+  }
+  if (ob >= 0) hess->block<6, 6>(ob, ob) += k * go * go.transpose();
 }
 
 double SdfContactTerm::friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda,
