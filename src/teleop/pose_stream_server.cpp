@@ -27,6 +27,8 @@ PoseStreamServer::PoseStreamServer(PoseStreamServerOptions options)
     : options_(std::move(options)), filter_(options_.checks) {
   require(options_.port >= 0 && options_.port <= 65535, "teleop stream port ", options_.port,
           ": expected 0 (pick a free one) or 1..65535");
+  require(options_.max_datagrams_per_poll >= 1, "teleop stream max_datagrams_per_poll ",
+          options_.max_datagrams_per_poll, ": expected >= 1");
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) fail("teleop stream: cannot open a UDP socket: ", std::strerror(errno));
   sockaddr_in addr{};
@@ -55,7 +57,7 @@ std::optional<StreamSample> PoseStreamServer::poll(double now, std::vector<Strea
   // Larger than any valid message so that oversize datagrams are seen (and
   // rejected as malformed) rather than silently truncated to a valid size.
   std::uint8_t buf[2048];
-  for (;;) {
+  for (int read = 0; read < options_.max_datagrams_per_poll;) {
     sockaddr_in from{};
     socklen_t from_len = sizeof from;
     const ssize_t n = ::recvfrom(fd_, buf, sizeof buf, MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &from_len);
@@ -63,6 +65,7 @@ std::optional<StreamSample> PoseStreamServer::poll(double now, std::vector<Strea
       if (errno == EINTR) continue;
       break;  // EAGAIN: drained (other errors: nothing more to read either)
     }
+    ++read;
     pending_from_.assign(reinterpret_cast<const std::uint8_t*>(&from),
                          reinterpret_cast<const std::uint8_t*>(&from) + sizeof from);
     // With MSG_TRUNC, n is the real datagram size even when it exceeded buf.

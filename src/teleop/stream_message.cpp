@@ -93,6 +93,19 @@ bool check_header(Reader& r, std::size_t size, std::uint16_t want_type, std::siz
   return true;
 }
 
+// Checks the framing and, when it is right, reads the body with `read_body(reader, message)`.
+template <class M, class ReadBody>
+Decoded<M> decode_framed(const std::uint8_t* data, std::size_t size, std::uint16_t type, std::size_t want_size,
+                         ReadBody read_body) {
+  Decoded<M> out;
+  Reader r(data);
+  if (!check_header(r, size, type, want_size, out)) return out;
+  M m;
+  read_body(r, m);
+  out.message = m;
+  return out;
+}
+
 }  // namespace
 
 const char* to_string(RejectReason reason) {
@@ -139,31 +152,24 @@ std::array<std::uint8_t, kFeedbackMessageSize> encode_feedback(const FeedbackMes
 }
 
 Decoded<PoseMessage> decode_pose(const std::uint8_t* data, std::size_t size) {
-  Decoded<PoseMessage> out;
-  Reader r(data);
-  if (!check_header(r, size, kPoseMessageType, kPoseMessageSize, out)) return out;
-  PoseMessage m;
-  m.sequence = r.u64();
-  m.sample.time = r.f64();
-  m.sample.position = r.vec();
-  const double w = r.f64(), x = r.f64(), y = r.f64(), z = r.f64();
-  m.sample.orientation = Eigen::Quaterniond(w, x, y, z);
-  m.sample.closure = r.f64();
-  out.message = m;
-  return out;
+  return decode_framed<PoseMessage>(data, size, kPoseMessageType, kPoseMessageSize, [](Reader& r, PoseMessage& m) {
+    m.sequence = r.u64();
+    m.sample.time = r.f64();
+    m.sample.position = r.vec();
+    const double w = r.f64(), x = r.f64(), y = r.f64(), z = r.f64();
+    m.sample.orientation = Eigen::Quaterniond(w, x, y, z);
+    m.sample.closure = r.f64();
+  });
 }
 
 Decoded<FeedbackMessage> decode_feedback(const std::uint8_t* data, std::size_t size) {
-  Decoded<FeedbackMessage> out;
-  Reader r(data);
-  if (!check_header(r, size, kFeedbackMessageType, kFeedbackMessageSize, out)) return out;
-  FeedbackMessage m;
-  m.sequence = r.u64();
-  m.sim_time = r.f64();
-  m.force = r.vec();
-  m.torque = r.vec();
-  out.message = m;
-  return out;
+  return decode_framed<FeedbackMessage>(data, size, kFeedbackMessageType, kFeedbackMessageSize,
+                                        [](Reader& r, FeedbackMessage& m) {
+                                          m.sequence = r.u64();
+                                          m.sim_time = r.f64();
+                                          m.force = r.vec();
+                                          m.torque = r.vec();
+                                        });
 }
 
 }  // namespace sflsh::teleop

@@ -170,6 +170,26 @@ TEST(PoseStreamServer, EveryKindOfBadDatagramIsLoggedCountedAndTheLastGoodPoseHe
   EXPECT_EQ(next->sequence, 7u);
 }
 
+TEST(PoseStreamServer, AFloodIsReadInBoundedChunksPerPoll) {
+  PoseStreamServerOptions o;
+  o.max_datagrams_per_poll = 4;
+  PoseStreamServer server(o);
+  Client client(server.port());
+  for (int i = 1; i <= 10; ++i) client.send_pose(pose(i, 0.001 * i, 0.0));
+  std::this_thread::sleep_for(std::chrono::milliseconds(2));  // all ten queued (loopback is immediate)
+  std::vector<StreamSample> accepted;
+  server.poll(0.0, &accepted);
+  EXPECT_EQ(server.counters().received, 4);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (accepted.size() < 10 && std::chrono::steady_clock::now() < deadline) {
+    const long before = server.counters().received;
+    server.poll(0.0, &accepted);
+    EXPECT_LE(server.counters().received - before, 4);
+  }
+  ASSERT_EQ(accepted.size(), 10u);
+  EXPECT_EQ(accepted.back().sequence, 10u);
+}
+
 TEST(PoseStreamServer, ServesAClientFromAThreadAtTheDeviceRate) {
   // The simulator side in its own thread: poll, answer each new sample.
   PoseStreamServer server;

@@ -16,6 +16,10 @@ struct PoseStreamServerOptions {
   /// UDP port on 127.0.0.1; 0 (default) lets the system pick a free one (see port()).
   int port = 0;
   PoseStreamCheckOptions checks;
+  /// Most datagrams one poll() reads (default 4096, > 4 s of a 1 kHz device):
+  /// bounds the work per simulation step when a sender floods the port; the
+  /// rest wait in the socket buffer for the next poll.
+  int max_datagrams_per_poll = 4096;
   /// Receives one line per rejected datagram. Default (empty): the line goes to stderr.
   std::function<void(const std::string&)> log;
 };
@@ -39,7 +43,8 @@ class PoseStreamServer {
   /// The bound UDP port (the picked one when options.port was 0).
   int port() const { return port_; }
 
-  /// Drains every pending datagram without blocking, checks each in arrival
+  /// Drains the pending datagrams (at most options.max_datagrams_per_poll)
+  /// without blocking, checks each in arrival
   /// order (one log line per rejected one) and returns the newest sample
   /// accepted in this call, or nothing when none was. `now` (s, the caller's
   /// clock, e.g. simulation time) is stamped as receive_time. When `accepted`
