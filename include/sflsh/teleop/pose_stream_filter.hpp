@@ -36,7 +36,9 @@ struct PoseStreamCounters {
 /// The stream checks of one device, in order: finite values, unit quaternion
 /// (normalized when within tolerance), closure in [0, pi], sequence number
 /// after the last accepted one, device time after the last accepted one,
-/// speed from the last accepted sample at most max_speed.
+/// speed from the last accepted sample at most max_speed. A device restarting
+/// its sequence numbers or clock from zero is therefore rejected until it
+/// passes the held values: make a new filter (server) for a new session.
 class PoseStreamFilter {
  public:
   explicit PoseStreamFilter(const PoseStreamCheckOptions& options = {});
