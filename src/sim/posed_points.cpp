@@ -1,5 +1,6 @@
 #include "sflsh/sim/posed_points.hpp"
 
+#include <algorithm>
 #include <map>
 
 #include "sflsh/core/error.hpp"
@@ -115,6 +116,37 @@ PosedPoints PosedPoints::subset(const std::vector<int>& rows) const {
     }
     P.handle_start_.push_back(int(P.handle_index_.size()));
   }
+  return P;
+}
+
+PosedPoints PosedPoints::with_truncated_rows(int max_handles, double* max_dropped) const {
+  require(max_handles >= 1, "PosedPoints::with_truncated_rows: max_handles = ", max_handles, ", expected >= 1");
+  PosedPoints P = *this;
+  P.handle_start_.assign(1, 0);
+  P.handle_index_.clear();
+  P.handle_weight_.clear();
+  double worst = 0;
+  std::vector<std::pair<double, int>> row;
+  for (int p = 0; p < size(); ++p) {
+    row.clear();
+    double total = 0, kept = 0;
+    for (int e = handle_start_[p]; e < handle_start_[p + 1]; ++e) {
+      row.emplace_back(handle_weight_[e], handle_index_[e]);
+      total += handle_weight_[e];
+    }
+    const size_t n = std::min<size_t>(row.size(), size_t(max_handles));
+    std::partial_sort(row.begin(), row.begin() + n, row.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (size_t i = 0; i < n; ++i) kept += row[i].first;
+    worst = std::max(worst, total - kept);
+    std::sort(row.begin(), row.begin() + n, [](const auto& a, const auto& b) { return a.second < b.second; });
+    const double scale = kept > 0 ? total / kept : 1.0;
+    for (size_t i = 0; i < n; ++i) {
+      P.handle_index_.push_back(row[i].second);
+      P.handle_weight_.push_back(row[i].first * scale);
+    }
+    P.handle_start_.push_back(int(P.handle_index_.size()));
+  }
+  if (max_dropped) *max_dropped = worst;
   return P;
 }
 

@@ -351,6 +351,50 @@ TEST(SdfContact, SampleSpacingKeepsOneVertexPerCell) {
   }
 }
 
+TEST(SdfContact, TruncatedSampleRowsKeepTheStrongestHandlesAndTheRowSum) {
+  const Avatar a = box(6);
+  const PosedPoints all = PosedPoints::at_surface(a);
+  double dropped = -1;
+  const PosedPoints two = all.with_truncated_rows(2, &dropped);
+  std::mt19937 rng(13);
+  const Configuration q = near_rest(a, rng);
+  double worst = 0;
+  for (int p = 0; p < all.size(); ++p) {
+    const PosedPoints::Rows r = all.rows(p), t = two.rows(p);
+    ASSERT_LE(t.num_handles, 2);
+    ASSERT_EQ(t.num_handles, std::min(2, r.num_handles));
+    // By hand: the two largest weights of the full row, scaled to its sum.
+    std::vector<std::pair<double, int>> w;
+    double total = 0;
+    for (int e = 0; e < r.num_handles; ++e) {
+      w.emplace_back(r.handle_weights[e], r.handles[e]);
+      total += r.handle_weights[e];
+    }
+    std::sort(w.rbegin(), w.rend());
+    double kept = 0, sum = 0;
+    for (int e = 0; e < t.num_handles; ++e) kept += w[e].first;
+    worst = std::max(worst, total - kept);
+    for (int e = 0; e < t.num_handles; ++e) {
+      sum += t.handle_weights[e];
+      // It is one of the strongest (ties may go either way), scaled by total / kept.
+      const auto it = std::find_if(w.begin(), w.end(), [&](const auto& x) { return x.second == t.handles[e]; });
+      ASSERT_NE(it, w.end());
+      EXPECT_GE(it->first, w[t.num_handles - 1].first - 1e-15) << "point " << p << " kept a weaker handle";
+      EXPECT_NEAR(t.handle_weights[e], it->first * total / kept, 1e-15);
+    }
+    EXPECT_NEAR(sum, total, 1e-14);
+    // Bones untouched: with z = 0 the points coincide.
+    Configuration q0 = q;
+    q0.z.setZero();
+    EXPECT_LT((two.world_point(p, q0) - all.world_point(p, q0)).norm(), 1e-15);
+  }
+  EXPECT_NEAR(dropped, worst, 1e-15);
+  EXPECT_GT(dropped, 0);
+  // Keeping every handle changes nothing.
+  const PosedPoints same = all.with_truncated_rows(1000);
+  for (int p = 0; p < all.size(); ++p) EXPECT_LT((same.world_point(p, q) - all.world_point(p, q)).norm(), 1e-15);
+}
+
 TEST(CapsuleContact, GradientHessianAndMomentumBetweenTwoBodies) {
   const Avatar a = box(), b = box();
   const double k = 1.0e4;

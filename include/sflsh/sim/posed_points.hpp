@@ -31,6 +31,12 @@ class PosedPoints {
 
   /// The points `rows` (indices into this set, in that order) as a set of their own.
   PosedPoints subset(const std::vector<int>& rows) const;
+  /// A copy whose basis rows keep only each point's `max_handles` (>= 1)
+  /// largest weights, scaled so that every row's sum is unchanged. The
+  /// largest weight dropped from a row (before scaling) goes to `max_dropped`
+  /// when non-null: the bound on how far a point moves differently, per metre
+  /// of handle displacement.
+  PosedPoints with_truncated_rows(int max_handles, double* max_dropped = nullptr) const;
 
   int size() const { return int(x_unposed_.rows()); }
   /// World position of point p for configuration q (m).

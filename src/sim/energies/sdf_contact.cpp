@@ -334,8 +334,9 @@ std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const C
           {"max_penetration", "m", VecX::Constant(1, depth)}};
 }
 
-PosedPoints skin_contact_samples(const Avatar& avatar, double spacing) {
+PosedPoints skin_contact_samples(const Avatar& avatar, double spacing, int max_handles, double* max_dropped) {
   PosedPoints all = PosedPoints::at_surface(avatar);
+  if (max_handles > 0) all = all.with_truncated_rows(max_handles, max_dropped);
   if (!(spacing > 0)) return all;
   // One vertex per cell: the one nearest the cell's centre.
   std::map<std::tuple<long, long, long>, std::pair<double, int>> best;

@@ -115,6 +115,12 @@ class SdfContactTerm : public EnergyTerm {
 /// The skin vertices of `avatar` to use as contact samples: every vertex
 /// (spacing ≤ 0), or one vertex per cubic cell of `spacing` m in the unposed
 /// space (the one nearest the cell's centre), so that density is uniform.
-PosedPoints skin_contact_samples(const Avatar& avatar, double spacing = 0.0);
+/// Each sample's basis row keeps its `max_handles` strongest handles (≤ 0:
+/// all; PosedPoints::with_truncated_rows): a sample's Gauss–Newton block
+/// costs (6 n_bones + 3 n_handles)², and the depth-blended basis gives skin
+/// points up to ~60 handles with weights down to 1e-4. Default 8: on the
+/// default avatar the largest weight dropped is reported by `max_dropped`.
+PosedPoints skin_contact_samples(const Avatar& avatar, double spacing = 0.0, int max_handles = 8,
+                                 double* max_dropped = nullptr);
 
 }  // namespace sflsh
