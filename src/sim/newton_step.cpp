@@ -180,6 +180,13 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
 
+    // Converged to round-off: the predicted decrease is below what the energy
+    // can resolve, so no line search could verify a step (it would "reject"
+    // an iterate that is already the minimum, e.g. a held grasp at rest).
+    if (o.line_search && -slope <= 1e-13 * std::max(1.0, std::abs(E0))) {
+      --rep.iterations;
+      break;
+    }
     double alpha = step_cap(delta, sys.bodies, o);
     std::vector<Configuration> trial;
     bool ok = false;
