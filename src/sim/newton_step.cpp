@@ -180,13 +180,6 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
 
-    // Converged to round-off: the predicted decrease is below what the energy
-    // can resolve, so no line search could verify a step (it would "reject"
-    // an iterate that is already the minimum, e.g. a held grasp at rest).
-    if (o.line_search && -slope <= 1e-13 * std::max(1.0, std::abs(E0))) {
-      --rep.iterations;
-      break;
-    }
     double alpha = step_cap(delta, sys.bodies, o);
     std::vector<Configuration> trial;
     bool ok = false;
@@ -205,6 +198,13 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
       }
     }
     rep.ms_assemble += tl.ms();
+    // Converged to round-off: the line search found no decrease, but the
+    // predicted one is below what the energy resolves. The iterate is the
+    // minimum (e.g. a held grasp at rest); keep it and stop, not a rejection.
+    if (!ok && o.line_search && -slope <= 1e-12 * std::max(1.0, std::abs(E0))) {
+      final_valid = false;
+      break;
+    }
     StepOutcome outcome;
     if (!ok) {
       final_valid = false;

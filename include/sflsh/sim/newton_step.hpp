@@ -18,9 +18,9 @@ struct NewtonOptions {
   /// Backtracking line search on the total energy (Armijo, halving, up to 20 halvings).
   /// Off: the full step is taken unless it makes the energy inadmissible (+inf,
   /// e.g. an inverted element), in which case it is halved until admissible.
-  /// With it, iterations also stop once the predicted decrease −gᵀδ falls to
-  /// 1e-13·max(1, |E|): converged to round-off, no energy test could accept
-  /// a step (it would be counted as rejected).
+  /// With it, a step whose line search finds no decrease while the predicted
+  /// one, −gᵀδ, is below 1e-12·max(1, |E|) ends the iterations as converged
+  /// (the iterate is kept) instead of counting as rejected.
   bool line_search = false;
   /// Largest change of any handle displacement z_k per iteration (m); longer
   /// steps are scaled down as a whole (counted as damped). ≤ 0 disables.
