@@ -335,16 +335,7 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
         p.max_force = std::max(p.max_force, p.last_force.norm());
       }
     }
-    r.step_time.push_back(t);
-    r.step_energy.push_back(rep.energy_after);
-    r.step_grad_norm.push_back(rep.grad_norm_before);
-    r.step_decrement.push_back(rep.newton_decrement);
-    r.step_outcome.push_back(int(rep.outcome));
-    r.step_ms.push_back(rep.ms_total);
-    r.add_step_times(rep);
-    r.accepted += rep.accepted;
-    r.damped += rep.damped;
-    r.rejected += rep.rejected;
+    r.add_step(t, rep);
     ms_since_frame += rep.ms_total;
     ++steps_since_frame;
     if (t + 1e-9 >= next_frame) {

@@ -47,6 +47,19 @@ void SimulationResult::add_step_times(const StepReport& rep) {
   add("solve", rep.ms_solve);
 }
 
+void SimulationResult::add_step(double t, const StepReport& rep) {
+  step_time.push_back(t);
+  step_energy.push_back(rep.energy_after);
+  step_grad_norm.push_back(rep.grad_norm_before);
+  step_decrement.push_back(rep.newton_decrement);
+  step_outcome.push_back(int(rep.outcome));
+  step_ms.push_back(rep.ms_total);
+  add_step_times(rep);
+  accepted += rep.accepted;
+  damped += rep.damped;
+  rejected += rep.rejected;
+}
+
 double SimulationResult::median_step_ms() const { return percentile(step_ms, 0.5); }
 double SimulationResult::p95_step_ms() const { return percentile(step_ms, 0.95); }
 
@@ -156,16 +169,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     const StepReport rep = sim.step(targets, pose);
     if (!finite_state(sim.state()) || !std::isfinite(rep.energy_after))
       fail(motion.name, ": simulation state became non-finite at step ", s + 1, " (t = ", t, " s); try a smaller --dt");
-    r.step_time.push_back(t);
-    r.step_energy.push_back(rep.energy_after);
-    r.step_grad_norm.push_back(rep.grad_norm_before);
-    r.step_decrement.push_back(rep.newton_decrement);
-    r.step_outcome.push_back(int(rep.outcome));
-    r.step_ms.push_back(rep.ms_total);
-    r.add_step_times(rep);
-    r.accepted += rep.accepted;
-    r.damped += rep.damped;
-    r.rejected += rep.rejected;
+    r.add_step(t, rep);
     ms_since_frame += rep.ms_total;
     ++steps_since_frame;
     if (options.on_step) options.on_step(sim, rep);

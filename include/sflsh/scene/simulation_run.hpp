@@ -91,6 +91,8 @@ struct SimulationResult {
 
   /// Adds a step's per-term and solve times to part_names/part_ms.
   void add_step_times(const StepReport& report);
+  /// Records a step ending at time t (s): the step_* series, its times and outcome counts.
+  void add_step(double t, const StepReport& report);
   /// Median / 95th percentile step wall time (ms).
   double median_step_ms() const;
   double p95_step_ms() const;
