@@ -137,6 +137,79 @@ objects:
   EXPECT_LT(res.frame_displacement.back().cwiseAbs().maxCoeff(), 1e-12);
 }
 
+TEST_F(SceneRun, AMeshObjectIsBakedAndPressesTheBody) {
+  // A closed cube (OBJ, 4 cm, in cm: scale 0.01) lowered 5 mm into the 6 cm top.
+  std::ofstream((dir_ / "cube.obj").string()) << R"(v -2 -2 -2
+v 2 -2 -2
+v 2 2 -2
+v -2 2 -2
+v -2 -2 2
+v 2 -2 2
+v 2 2 2
+v -2 2 2
+f 1 4 3
+f 1 3 2
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 4 8 7
+f 4 7 3
+f 1 5 8
+f 1 8 4
+f 2 3 7
+f 2 7 6
+)";
+  SceneDescription sc = read_scene_description(write_scene(R"(
+solver: {dt: 1/60, seconds: 0.5, gravity: [0, 0, 0]}
+output: {fps: 10}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - name: block
+    shape: {type: mesh, file: cube.obj, scale: 0.01, voxel_size: 0.002, padding: 0.01}
+    kind: kinematic
+    keyframes:
+      - {time: 0.0, position: [0, 0.06, 0]}
+      - {time: 0.5, position: [0, 0.045, 0]}
+)"));
+  validate_scene_files(sc);
+  SceneContactStats stats;
+  SceneRunOptions opt;
+  opt.progress = false;
+  const SimulationResult res = run_scene(sc, opt, &stats);
+  ASSERT_EQ(res.objects.size(), 1u);
+  EXPECT_EQ(res.objects[0].shape, "mesh");
+  EXPECT_EQ(res.objects[0].vertices.rows(), 8);
+  EXPECT_NEAR(res.objects[0].vertices.cwiseAbs().maxCoeff(), 0.02, 1e-12);
+  // The cube's bottom ends 5 mm below the top (y = 0.03): the skin under it is pushed down.
+  ASSERT_FALSE(stats.pairs.empty());
+  EXPECT_EQ(stats.pairs[0].term, "contact:block");
+  EXPECT_GT(stats.pairs[0].max_force, 0);
+  EXPECT_LT(stats.pairs[0].max_penetration, 0.005);
+  const Points& x = res.frame_positions.back();
+  double lowest_top = 1;
+  for (int v = 0; v < x.rows(); ++v)
+    if (std::abs(x(v, 0)) < 0.015 && std::abs(x(v, 2)) < 0.015 && x(v, 1) > 0.02) lowest_top = std::min(lowest_top, x(v, 1));
+  EXPECT_LT(lowest_top, 0.03 - 0.002) << "the skin under the block did not move down";
+  // An open mesh (one face removed) is refused, naming the file.
+  std::ofstream((dir_ / "open.obj").string()) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";
+  SceneDescription bad = read_scene_description(write_scene(R"(
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+solver: {seconds: 0.1}
+objects:
+  - {name: lid, shape: {type: mesh, file: open.obj}}
+)"));
+  try {
+    validate_scene_files(bad);
+    ADD_FAILURE() << "an open mesh was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("open.obj"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("objects[0].shape"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(SceneRun, CliRunsASceneFileAndRefusesOneAvatarFlagsWithIt) {
   const std::string scene = write_scene(R"(
 solver: {dt: 1/60, seconds: 0.2}
