@@ -57,6 +57,13 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   }
   write_simulation_result(r, out.out);
   std::cout << r.describe() << stats.describe() << "wrote " << out.out << " (" << r.num_frames << " frames)\n";
+  if (!stats.tool_steps.empty()) {
+    // The tools' forces and anchors per step, next to the result.
+    const std::filesystem::path p(out.out);
+    const std::string log = (p.parent_path() / (p.stem().string() + "_tools.csv")).string();
+    stats.write_tool_log(log);
+    std::cout << "wrote " << log << " (force on each tool and its anchors, per step)\n";
+  }
   if (!out.export_path.empty()) std::cout << export_result(r, out.export_path) << "\n";
   if (!out.render.empty()) {
     render_result(r, out.render, out.render_frames);

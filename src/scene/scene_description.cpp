@@ -299,6 +299,57 @@ RigidObjectDescription parse_object(const SceneParser& p, const YAML::Node& n, c
   return o;
 }
 
+ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std::string& key) {
+  p.check_map(n, key, {"name", "shape", "keyframes", "pose_file", "grasp"}, "a tool");
+  auto k = [&](const std::string& c) { return SceneParser::child_key(key, c); };
+  ToolDescription t;
+  t.name = p.text(p.required(n, key, "name"), k("name"));
+  if (const auto s = n["shape"]) {
+    t.shape = parse_shape(p, s, k("shape"));
+    t.has_shape = true;
+  }
+  const YAML::Node kf = n["keyframes"], file = n["pose_file"];
+  if (bool(kf) == bool(file)) p.error(n, key, "give exactly one pose source: 'keyframes' or 'pose_file'");
+  if (file) t.pose_file = p.existing_file(file, k("pose_file"), "pose file");
+  if (kf) {
+    if (!kf.IsSequence() || kf.size() == 0) p.error(kf, k("keyframes"), "expected a list of at least one keyframe");
+    for (std::size_t i = 0; i < kf.size(); ++i) {
+      const std::string ik = SceneParser::item_key(k("keyframes"), i);
+      p.check_map(kf[i], ik, {"time", "position", "orientation", "closure"}, "a tool keyframe");
+      ToolKeyframe f;
+      f.time = p.non_negative(p.required(kf[i], ik, "time"), ik + ".time");
+      f.position = p.vec3(p.required(kf[i], ik, "position"), ik + ".position");
+      if (const auto q = kf[i]["orientation"]) f.orientation = p.quaternion(q, ik + ".orientation");
+      if (const auto c = kf[i]["closure"]) f.closure = p.non_negative(c, ik + ".closure");
+      if (i > 0 && f.time <= t.keyframes.back().time)
+        p.error(kf[i], ik + ".time", "keyframe times must increase, got ", f.time, " after ", t.keyframes.back().time);
+      t.keyframes.push_back(f);
+    }
+  }
+  if (const auto g = n["grasp"]) {
+    const std::string gk = k("grasp");
+    p.check_map(g, gk, {"sensors", "closure_threshold", "hardness", "damping"}, "a grasp");
+    const YAML::Node ss = p.required(g, gk, "sensors");
+    if (!ss.IsSequence() || ss.size() == 0) p.error(ss, gk + ".sensors", "expected a list of at least one sensor");
+    for (std::size_t i = 0; i < ss.size(); ++i) {
+      const std::string sk = SceneParser::item_key(gk + ".sensors", i);
+      p.check_map(ss[i], sk, {"origin", "direction", "range"}, "a proximity sensor");
+      ToolSensorDescription sd;
+      if (const auto o = ss[i]["origin"]) sd.origin = p.vec3(o, sk + ".origin");
+      const YAML::Node d = p.required(ss[i], sk, "direction");
+      sd.direction = p.vec3(d, sk + ".direction");
+      if (sd.direction.norm() < 1e-9) p.error(d, sk + ".direction", "must not be zero");
+      sd.direction.normalize();
+      sd.range = p.positive(p.required(ss[i], sk, "range"), sk + ".range");
+      t.sensors.push_back(sd);
+    }
+    if (const auto v = g["closure_threshold"]) t.closure_threshold = p.non_negative(v, gk + ".closure_threshold");
+    if (const auto v = g["hardness"]) t.hardness = p.positive(v, gk + ".hardness");
+    if (const auto v = g["damping"]) t.damping = p.non_negative(v, gk + ".damping");
+  }
+  return t;
+}
+
 ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, const SceneDescription& scene) {
   const std::string key = "contact";
   p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs"}, "the contact settings");
@@ -423,7 +474,7 @@ SceneDescription read_scene_description(const std::string& path) {
   const fs::path folder = fs::absolute(path).parent_path();
   const SceneParser p(path, folder);
   if (!root.IsMap()) fail(path, ": expected a map with 'bodies' (and optionally objects, contact, solver, output)");
-  p.check_map(root, "", {"solver", "output", "contact", "bodies", "objects"}, "a scene");
+  p.check_map(root, "", {"solver", "output", "contact", "bodies", "objects", "tools"}, "a scene");
 
   SceneDescription scene;
   scene.path = path;
@@ -431,7 +482,7 @@ SceneDescription read_scene_description(const std::string& path) {
   auto unique_name = [&](const YAML::Node& item, const std::string& key, const std::string& name) {
     if (name.empty()) p.error(item["name"], key + ".name", "must not be empty");
     if (!names.insert(name).second)
-      p.error(item["name"], key + ".name", "the name '", name, "' is used twice (names are unique across bodies and objects)");
+      p.error(item["name"], key + ".name", "the name '", name, "' is used twice (names are unique across bodies, objects and tools)");
   };
   const YAML::Node bodies = p.required(root, "", "bodies");
   if (!bodies.IsSequence() || bodies.size() == 0) p.error(bodies, "bodies", "expected a list of at least one body");
@@ -446,6 +497,14 @@ SceneDescription read_scene_description(const std::string& path) {
       const std::string key = SceneParser::item_key("objects", i);
       scene.objects.push_back(parse_object(p, objects[i], key));
       unique_name(objects[i], key, scene.objects.back().name);
+    }
+  }
+  if (const auto tools = root["tools"]) {
+    if (!tools.IsSequence()) p.error(tools, "tools", "expected a list of tools");
+    for (std::size_t i = 0; i < tools.size(); ++i) {
+      const std::string key = SceneParser::item_key("tools", i);
+      scene.tools.push_back(parse_tool(p, tools[i], key));
+      unique_name(tools[i], key, scene.tools.back().name);
     }
   }
   if (const auto c = root["contact"]) scene.contact = parse_contact(p, c, scene);
@@ -542,6 +601,39 @@ void emit_object(YAML::Emitter& e, const RigidObjectDescription& o) {
 
 }  // namespace
 
+void emit_tool(YAML::Emitter& e, const ToolDescription& t) {
+  e << YAML::BeginMap << YAML::Key << "name" << YAML::Value << t.name;
+  if (t.has_shape) {
+    e << YAML::Key << "shape" << YAML::Value;
+    emit_shape(e, t.shape);
+  }
+  if (!t.pose_file.empty()) {
+    e << YAML::Key << "pose_file" << YAML::Value << t.pose_file;
+  } else {
+    e << YAML::Key << "keyframes" << YAML::Value << YAML::BeginSeq;
+    for (const auto& f : t.keyframes) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "time" << YAML::Value << num(f.time);
+      emit_pose(e, f.position, f.orientation);
+      e << YAML::Key << "closure" << YAML::Value << num(f.closure) << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+  }
+  if (!t.sensors.empty()) {
+    e << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
+    for (const auto& sd : t.sensors) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "origin" << YAML::Value;
+      emit(e, sd.origin);
+      e << YAML::Key << "direction" << YAML::Value;
+      emit(e, sd.direction);
+      e << YAML::Key << "range" << YAML::Value << num(sd.range) << YAML::EndMap;
+    }
+    e << YAML::EndSeq << YAML::Key << "closure_threshold" << YAML::Value << num(t.closure_threshold) << YAML::Key
+      << "hardness" << YAML::Value << num(t.hardness) << YAML::Key << "damping" << YAML::Value << num(t.damping)
+      << YAML::EndMap;
+  }
+  e << YAML::EndMap;
+}
+
 std::string scene_description_yaml(const SceneDescription& scene) {
   YAML::Emitter e;
   e << YAML::BeginMap;
@@ -592,6 +684,11 @@ std::string scene_description_yaml(const SceneDescription& scene) {
   if (!scene.objects.empty()) {
     e << YAML::Key << "objects" << YAML::Value << YAML::BeginSeq;
     for (const auto& obj : scene.objects) emit_object(e, obj);
+    e << YAML::EndSeq;
+  }
+  if (!scene.tools.empty()) {
+    e << YAML::Key << "tools" << YAML::Value << YAML::BeginSeq;
+    for (const auto& t : scene.tools) emit_tool(e, t);
     e << YAML::EndSeq;
   }
   e << YAML::EndMap;

@@ -1,6 +1,7 @@
 #include "sflsh/scene/scene_run.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -16,7 +17,12 @@
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/rigid_object.hpp"
 #include "sflsh/sim/avatar_model.hpp"
+#include "sflsh/io/atomic_output.hpp"
+#include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/grasp_controller.hpp"
+#include "sflsh/teleop/pose_file.hpp"
+#include "sflsh/teleop/pose_track.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/momentum.hpp"
 #include "sflsh/sim/rigid_body_terms.hpp"
@@ -26,6 +32,9 @@
 
 namespace sflsh {
 namespace {
+
+using teleop::PoseSample;
+using teleop::PoseTrack;
 
 /// A body of the scene as the run drives it.
 struct SceneBody {
@@ -65,6 +74,31 @@ std::string motion_spec_name(const std::string& spec) {
   return slash == std::string::npos ? spec : spec.substr(slash + 1);
 }
 
+/// A tool as the run drives it: its pose track, contact field, and per body
+/// a grasp controller with its anchor term's key.
+struct SceneTool {
+  const ToolDescription* desc = nullptr;
+  std::unique_ptr<PoseTrack> track;
+  RigidObjectModel shape;  ///< when desc->has_shape
+  std::vector<GraspController> grasps;  ///< per body (when the tool has sensors)
+  std::vector<std::string> anchor_keys;  ///< per body: the anchor term's tool name
+  size_t logged_events = 0;
+};
+
+PoseTrack tool_track(const ToolDescription& t) {
+  if (!t.pose_file.empty()) return PoseTrack(teleop::read_pose_file(t.pose_file), t.pose_file);
+  std::vector<PoseSample> samples;
+  for (const ToolKeyframe& k : t.keyframes) samples.push_back({k.time, k.position, k.orientation, k.closure});
+  return PoseTrack(std::move(samples), "tool '" + t.name + "' keyframes");
+}
+
+Isometry sample_pose(const PoseSample& s) {
+  Isometry T = Isometry::Identity();
+  T.linear() = s.orientation.normalized().toRotationMatrix();
+  T.translation() = s.position;
+  return T;
+}
+
 /// Where body `b` starts: the placed motion at t = 0, moving with the motion
 /// (and the body's velocity) over the first step.
 BodyState initial_state(const SceneBody& b, double h) {
@@ -83,9 +117,35 @@ BodyState initial_state(const SceneBody& b, double h) {
 
 }  // namespace
 
+void SceneContactStats::write_tool_log(const std::string& path) const {
+  io::AtomicOutput out(path);
+  {
+    std::ofstream o(out.temp_path());
+    require(bool(o), path, ": cannot write the tool log");
+    o << "time,tool,fx,fy,fz,anchors,max_stretch\n" << std::setprecision(9);
+    for (const ToolStep& s : tool_steps)
+      o << s.time << "," << s.tool << "," << s.force.x() << "," << s.force.y() << "," << s.force.z() << ","
+        << s.anchors << "," << s.max_stretch << "\n";
+    require(bool(o), path, ": writing the tool log failed");
+  }
+  out.commit();
+}
+
 std::string SceneContactStats::describe() const {
   std::ostringstream o;
   o << std::fixed;
+  for (const ToolEvent& e : tool_events)
+    o << "tool " << e.tool << " t = " << std::setprecision(3) << e.time << " s: " << e.kind << " " << e.points
+      << " skin points of " << e.body << "\n";
+  if (!tool_steps.empty()) {
+    double fmax = 0, stretch = 0;
+    for (const ToolStep& s : tool_steps) {
+      fmax = std::max(fmax, s.force.norm());
+      stretch = std::max(stretch, s.max_stretch);
+    }
+    o << "tools: peak force " << std::setprecision(2) << fmax << " N, largest anchor stretch "
+      << stretch * 1e3 << " mm\n";
+  }
   for (const Pair& p : pairs)
     o << "contact " << p.term << " on " << p.body << ": max penetration " << std::setprecision(2)
       << p.max_penetration * 1e3 << " mm, max force " << std::setprecision(1) << p.max_force << " N, in contact "
@@ -191,6 +251,47 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
       }
     }
   }
+  // Tools: kinematic frames; contact with every body through their shape,
+  // grasping through anchors (one anchor term per tool and body).
+  std::vector<SceneTool> tools(sc.tools.size());
+  for (size_t i = 0; i < sc.tools.size(); ++i) {
+    SceneTool& t = tools[i];
+    t.desc = &sc.tools[i];
+    try {
+      t.track = std::make_unique<PoseTrack>(tool_track(*t.desc));
+    } catch (const Error& e) {
+      fail(sc.path, ": tools '", t.desc->name, "': ", e.what());
+    }
+    if (t.desc->has_shape) {
+      RigidObjectDescription as_object;
+      as_object.name = t.desc->name;
+      as_object.shape = t.desc->shape;
+      as_object.kind = ObjectKind::Kinematic;
+      t.shape = make_rigid_object(as_object, opt.cache_dir);
+    }
+    for (const SceneBody& b : bodies) {
+      if (t.desc->has_shape) {
+        auto& pts = samples[b.avatar.get()];
+        if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
+        SdfContactOptions co;
+        co.stiffness = c.body_object_stiffness;
+        co.friction = c.friction;
+        mb.add_term(std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
+                                                           false, co),
+                    {b.model_index});
+      }
+      if (!t.desc->sensors.empty()) {
+        GraspOptions go;
+        for (const ToolSensorDescription& sd : t.desc->sensors) go.sensors.push_back({sd.origin, sd.direction, sd.range});
+        go.closure_threshold = t.desc->closure_threshold;
+        t.grasps.emplace_back(go);
+        t.anchor_keys.push_back(t.desc->name + "@" + b.desc->name);
+        mb.add_term(std::make_shared<const AnchorTerm>(t.anchor_keys.back(), PosedPoints::at_surface(*b.avatar), false,
+                                                       AnchorOptions{t.desc->hardness, t.desc->damping}),
+                    {b.model_index});
+      }
+    }
+  }
   for (size_t i = 0; i < bodies.size(); ++i) {
     const SceneBody& a = bodies[i];
     for (size_t j = i + 1; j < bodies.size(); ++j) {
@@ -257,6 +358,10 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     r.objects.push_back({o.desc->name, shape_type_name(o.desc->shape.type), object_kind_name(o.desc->kind),
                          o.model.surface.vertices, o.model.surface.faces, {}});
 
+  for (const SceneTool& t : tools)
+    if (t.desc->has_shape)
+      r.objects.push_back({t.desc->name, shape_type_name(t.desc->shape.type), "kinematic", t.shape.surface.vertices,
+                           t.shape.surface.faces, {}});
   auto object_pose = [&](const SceneObject& o, double t) {
     if (o.model_index < 0) return object_pose_at(*o.desc, t);
     return Isometry(sim.state(o.model_index).bones[0] * o.model.shape_in_body);
@@ -284,6 +389,9 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     r.frame_reduced.push_back(std::move(reduced));
     r.frame_target_pelvis.push_back(placed_pose(b0, t).translation + b0.avatar->joints_rest.row(0).transpose());
     for (size_t i = 0; i < objects.size(); ++i) r.objects[i].poses.push_back(object_pose(objects[i], t));
+    size_t next = objects.size();
+    for (const SceneTool& tl : tools)
+      if (tl.desc->has_shape) r.objects[next++].poses.push_back(sample_pose(tl.track->at(t)));
     ++r.num_frames;
   };
   record_frame(0.0, 0.0);
@@ -313,7 +421,41 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
       f.linear_velocity = (f.pose.translation() - before.translation()) / h;
       f.angular_velocity = rotation_log(f.pose.linear() * before.linear().transpose()) / h;
     }
+    for (SceneTool& tl : tools) {
+      const PoseSample now = tl.track->at(t - h), then = tl.track->at(t);
+      WorldFrame f;
+      f.pose = sample_pose(then);
+      const Isometry before = sample_pose(now);
+      f.linear_velocity = (f.pose.translation() - before.translation()) / h;
+      f.angular_velocity = rotation_log(f.pose.linear() * before.linear().transpose()) / h;
+      in.frames[tl.desc->name] = f;
+      for (size_t bi = 0; bi < tl.grasps.size(); ++bi) {
+        const SceneBody& b = bodies[bi];
+        tl.grasps[bi].update(t - h, before, now.closure, sim.posed_surface(b.model_index), b.avatar->surface_faces);
+        add_anchor_frames(tl.anchor_keys[bi], f, tl.grasps[bi].anchors(), false, in.frames);
+        for (; st.tool_events.size() < 100000 && tl.grasps[bi].log().size() > st.tool_events_seen[tl.anchor_keys[bi]];
+             ++st.tool_events_seen[tl.anchor_keys[bi]]) {
+          const GraspEvent& ev = tl.grasps[bi].log()[st.tool_events_seen[tl.anchor_keys[bi]]];
+          st.tool_events.push_back({ev.time, tl.desc->name, b.desc->name,
+                                    ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
+        }
+      }
+    }
     const StepReport rep = sim.step(in);
+    // Tool feedback: the force on each tool is minus what its contact and
+    // anchor terms exert on the bodies.
+    for (const SceneTool& tl : tools) {
+      SceneContactStats::ToolStep ts{t, tl.desc->name};
+      for (const TermQuantityReport& q : rep.quantities) {
+        const bool contact = q.term == "contact:" + tl.desc->name;
+        const bool anchor = q.term.rfind("anchor:" + tl.desc->name + "@", 0) == 0;
+        if ((contact || anchor) && q.name == "force" && q.value.size() == 3)
+          ts.force -= Vec3(q.value[0], q.value[1], q.value[2]);
+        if (anchor && q.name == "anchor_points") ts.anchors += int(q.value.size());
+        if (anchor && q.name == "max_stretch") ts.max_stretch = std::max(ts.max_stretch, q.value[0]);
+      }
+      st.tool_steps.push_back(ts);
+    }
     for (const SceneBody& b : bodies)
       if (!sim.state(b.model_index).z.allFinite() || !sim.state(b.model_index).bones[0].matrix().allFinite())
         fail(sc.path, ": body '", b.desc->name, "' became non-finite at step ", k + 1, " (t = ", t,

@@ -105,6 +105,58 @@ objects:
   validate_scene_files(s);  // ball.obj is closed
 }
 
+TEST(SceneDescription, ToolsParseRoundTripAndRejectBadInput) {
+  const std::string head = "bodies:\n  - {name: a, avatar: avatar.h5}\nsolver: {seconds: 1}\ntools:\n";
+  SceneFolder folder;
+  const std::string path = folder.write("scene.yaml", head + R"(  - name: pincher
+    shape: {type: capsule, radius: 0.005, length: 0.03}
+    keyframes:
+      - {time: 0, position: [0.1, 1.1, 0.12], closure: 1.25}
+      - {time: 0.5, position: [0.1, 1.2, 0.12], orientation: [0, 0, 1, 0], closure: 0.05}
+    grasp:
+      sensors: [{origin: [0, 0.01, 0], direction: [0, 0, -2], range: 0.015}]
+      closure_threshold: 0.3
+      hardness: 3.5e4
+      damping: 2.5
+)");
+  const SceneDescription s = read_scene_description(path);
+  ASSERT_EQ(s.tools.size(), 1u);
+  const ToolDescription& t = s.tools[0];
+  EXPECT_TRUE(t.has_shape);
+  EXPECT_EQ(t.shape.type, ShapeType::Capsule);
+  ASSERT_EQ(t.keyframes.size(), 2u);
+  EXPECT_EQ(t.keyframes[1].position, Vec3(0.1, 1.2, 0.12));
+  EXPECT_EQ(t.keyframes[1].closure, 0.05);
+  EXPECT_EQ(t.keyframes[1].orientation.y(), 1.0);
+  ASSERT_EQ(t.sensors.size(), 1u);
+  EXPECT_EQ(t.sensors[0].direction, Vec3(0, 0, -1));  // normalized
+  EXPECT_EQ(t.sensors[0].origin, Vec3(0, 0.01, 0));
+  EXPECT_EQ(t.sensors[0].range, 0.015);
+  EXPECT_EQ(t.closure_threshold, 0.3);
+  EXPECT_EQ(t.hardness, 3.5e4);
+  EXPECT_EQ(t.damping, 2.5);
+  // Written and read back: the same tool.
+  const std::string again = folder.write("again.yaml", scene_description_yaml(s));
+  const SceneDescription r = read_scene_description(again);
+  ASSERT_EQ(r.tools.size(), 1u);
+  EXPECT_EQ(r.tools[0].keyframes[1].closure, 0.05);
+  EXPECT_EQ(r.tools[0].sensors[0].range, 0.015);
+  EXPECT_EQ(r.tools[0].hardness, 3.5e4);
+  EXPECT_EQ(r.tools[0].shape.radius, 0.005);
+  // Bad input: file, line, key path.
+  expect_scene_error(head + "  - name: g\n    grasp: {sensors: [{direction: [0, 0, 1], range: 0.01}]}\n",
+                     {"scene.yaml:5:", "tools[0]", "exactly one pose source"});
+  expect_scene_error(head + "  - name: g\n    pose_file: nowhere.csv\n",
+                     {"scene.yaml:6:", "tools[0].pose_file", "pose file not found"});
+  expect_scene_error(head + "  - name: g\n    keyframes: [{time: 0, position: [0, 0, 0]}]\n"
+                            "    grasp: {sensors: [{direction: [0, 0, 0], range: 0.01}]}\n",
+                     {"scene.yaml:7:", "tools[0].grasp.sensors[0].direction", "must not be zero"});
+  expect_scene_error(head + "  - name: a\n    keyframes: [{time: 0, position: [0, 0, 0]}]\n",
+                     {"tools[0].name", "used twice"});
+  expect_scene_error(head + "  - name: g\n    keyframes: [{time: 0, position: [0, 0, 0], closing: 1}]\n",
+                     {"tools[0].keyframes[0].closing", "unknown key"});
+}
+
 TEST(SceneDescription, UnknownKeys) {
   expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1}\nobject: []\n",
                      {"scene.yaml:5:", "object", "unknown key 'object'", "objects"});

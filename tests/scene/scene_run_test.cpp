@@ -210,6 +210,73 @@ objects:
   }
 }
 
+TEST_F(SceneRun, AToolPinchesLiftsAndReleasesTheFlesh) {
+  // A gripper frame 5 mm above the 6 cm top, one sensor looking down: it
+  // closes (closure 1 → 0 rad by 0.1 s), lifts 5 mm by 0.4 s, holds, opens at 0.6 s.
+  SceneDescription sc = read_scene_description(write_scene(R"(
+solver: {dt: 1/60, seconds: 1.6, gravity: [0, 0, 0]}
+output: {fps: 60}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.001, 0.035, 0.002], closure: 1.0}
+      - {time: 0.1, position: [0.001, 0.035, 0.002], closure: 0.0}
+      - {time: 0.4, position: [0.001, 0.040, 0.002], closure: 0.0}
+      - {time: 0.55, position: [0.001, 0.040, 0.002], closure: 0.0}
+      - {time: 0.6, position: [0.001, 0.040, 0.002], closure: 1.0}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.01}]
+      closure_threshold: 0.2
+      hardness: 2.0e4
+      damping: 1.0
+)"));
+  SceneContactStats stats;
+  SceneRunOptions opt;
+  opt.progress = false;
+  const SimulationResult res = run_scene(sc, opt, &stats);
+  // One grasp (closure below 0.2 rad at t = 0.08 s), one release (above at 0.56 s).
+  ASSERT_EQ(stats.tool_events.size(), 2u);
+  EXPECT_EQ(stats.tool_events[0].kind, "grasp");
+  EXPECT_GT(stats.tool_events[0].points, 0);
+  EXPECT_NEAR(stats.tool_events[0].time, 0.1, 0.03);
+  EXPECT_EQ(stats.tool_events[1].kind, "release");
+  EXPECT_NEAR(stats.tool_events[1].time, 0.57, 0.03);
+  // Through the lift the anchored skin stays within 1 mm of its jaw offsets,
+  // and the tool feels the flesh pulling it down.
+  double stretch = 0, pull = 0;
+  for (const auto& s : stats.tool_steps)
+    if (s.time > 0.1 && s.time < 0.55) {
+      EXPECT_GT(s.anchors, 0) << "t = " << s.time;
+      stretch = std::max(stretch, s.max_stretch);
+      pull = std::min(pull, s.force.y());
+    }
+  EXPECT_LT(stretch, 1e-3);
+  EXPECT_LT(pull, 0);
+  // The top under the gripper rose with it (~5 mm), then went back to rest.
+  auto top_under_gripper = [&](int frame) {
+    const Points& x = res.frame_positions[frame];
+    double y = -1;
+    for (int v = 0; v < x.rows(); ++v)
+      if (std::abs(x(v, 0) - 0.001) < 0.006 && std::abs(x(v, 2) - 0.002) < 0.006) y = std::max(y, x(v, 1));
+    return y;
+  };
+  size_t lifted = 0;
+  while (res.frame_time[lifted] < 0.5) ++lifted;
+  EXPECT_GT(top_under_gripper(int(lifted)), 0.03 + 0.003);
+  EXPECT_LT(std::abs(top_under_gripper(int(res.frame_time.size()) - 1) - 0.03), 1e-3);
+  // The tool log has a row per step.
+  const std::string log = (dir_ / "tools.csv").string();
+  stats.write_tool_log(log);
+  std::ifstream in(log);
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 1 + int(stats.tool_steps.size()));
+  EXPECT_EQ(int(stats.tool_steps.size()), 96);
+}
+
 TEST_F(SceneRun, CliRunsASceneFileAndRefusesOneAvatarFlagsWithIt) {
   const std::string scene = write_scene(R"(
 solver: {dt: 1/60, seconds: 0.2}

@@ -68,6 +68,18 @@
 //       keyframes:              # required, times >= 0 strictly increasing
 //         - {time: 0, position: [0, 1.3, 0.3], orientation: [1, 0, 0, 0]}
 //         - {time: 2, position: [0, 1.1, 0.3]}   # orientation defaults to identity
+//   tools:                      # optional: teleoperated tools (issue 11), kinematic frames
+//     - name: pincher           # required; unique across bodies, objects and tools
+//       shape: {type: capsule, radius: 0.005, length: 0.03}  # optional contact shape (as objects')
+//       keyframes:              # the pose source: keyframes, or `pose_file` (exactly one)
+//         - {time: 0, position: [0, 1.1, 0.12], orientation: [1, 0, 0, 0], closure: 1.0}
+//         - {time: 0.2, position: [0, 1.1, 0.12], closure: 0}   # closure: jaw opening, rad
+//       pose_file: pinch.csv    # CSV (time,x,y,z,qw,qx,qy,qz,closure) or JSON lines (README)
+//       grasp:                  # optional: proximity sensors and anchors (AMBF Alg. 3)
+//         sensors: [{origin: [0, 0, 0], direction: [0, 0, -1], range: 0.01}]  # tool frame, m
+//         closure_threshold: 0.2   # rad: anchors while the closure is below it; default 0.2
+//         hardness: 2.0e4          # N/m per anchor; default 2e4
+//         damping: 1.0             # N·s/m per anchor; default 1
 //
 // Shapes (local frame; axes of symmetry along local +Y; lengths in m, > 0):
 //   plane    {normal: [0, 1, 0]}               half-space below the plane through the
@@ -154,6 +166,35 @@ struct RigidObjectDescription {
   Vec3 angular_velocity = Vec3::Zero();  ///< dynamic: rad/s, world axes
 };
 
+/// A pose of a tool at a time: keyframe of its pose source.
+struct ToolKeyframe {
+  double time = 0;                                                  ///< s
+  Vec3 position = Vec3::Zero();                                     ///< m, world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< unit, tool to world
+  double closure = 0;  ///< gripper jaw opening (rad, 0 = shut; teleop/pose_sample.hpp)
+};
+
+/// A proximity sensor on a tool: a ray in the tool's frame (AMBF Fig. 5).
+struct ToolSensorDescription {
+  Vec3 origin = Vec3::Zero();     ///< m, tool frame
+  Vec3 direction = -Vec3::UnitY();  ///< unit, tool frame
+  double range = 0.01;            ///< m
+};
+
+/// A teleoperated tool (issue 11): a kinematic frame driven by its pose
+/// source, optionally with a contact shape and a grasp (sensors + anchors).
+struct ToolDescription {
+  std::string name;
+  bool has_shape = false;
+  ShapeDescription shape;                  ///< contact shape (when has_shape)
+  std::vector<ToolKeyframe> keyframes;     ///< pose source: keyframes ...
+  std::string pose_file;                   ///< ... or a pose file (CSV / JSON lines), absolute
+  std::vector<ToolSensorDescription> sensors;  ///< grasp sensors; none: the tool cannot grasp
+  double closure_threshold = 0.2;          ///< rad: grasp while the closure is below it
+  double hardness = 2.0e4;                 ///< N/m per anchor
+  double damping = 1.0;                    ///< N·s/m per anchor
+};
+
 struct ContactDescription {
   double body_object_stiffness = 2.0e5;  ///< N/m per skin sample
   double body_body_stiffness = 1.0e6;    ///< N/m per capsule pair
@@ -188,6 +229,7 @@ struct SceneDescription {
   std::string path;                     ///< the file it was read from ("" if built in code)
   std::vector<BodyDescription> bodies;
   std::vector<RigidObjectDescription> objects;
+  std::vector<ToolDescription> tools;
   ContactDescription contact;
   SolverDescription solver;
   OutputDescription output;

@@ -16,11 +16,16 @@
 //   * bodies that collide with another body track their motion's root with a
 //     force limit (body_push_limit × body weight) so that contact, not the
 //     motion, decides where they meet;
+//   * tools (issue 11) are kinematic frames following keyframes or a pose
+//     file: with a shape they touch every body (SdfContactTerm), with sensors
+//     they grasp (GraspController, AMBF Alg. 3) through one AnchorTerm per
+//     body; the force on the tool is minus what those terms exert;
 //   * contact: one SdfContactTerm per colliding body–object pair (skin samples
 //     every `sample_spacing`), one CapsuleContactTerm per colliding pair of
 //     bodies (skipped when both are kinematic), and one per body with
 //     self_contact; object–object contact is not modelled.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -50,7 +55,27 @@ struct SceneContactStats {
   std::vector<Pair> pairs;
   /// Total linear momentum of the model at the first and last step (kg·m/s).
   Vec3 momentum_start = Vec3::Zero(), momentum_end = Vec3::Zero();
+  /// Tools, per step: the force on the tool (what its contact and anchors
+  /// take from the bodies, N, world), its anchors and their largest stretch (m).
+  struct ToolStep {
+    double time = 0;
+    std::string tool;
+    Vec3 force = Vec3::Zero();
+    int anchors = 0;
+    double max_stretch = 0;
+  };
+  std::vector<ToolStep> tool_steps;
+  /// Grasp and release events.
+  struct ToolEvent {
+    double time = 0;
+    std::string tool, body, kind;  ///< kind: "grasp" | "release"
+    int points = 0;
+  };
+  std::vector<ToolEvent> tool_events;
+  std::map<std::string, size_t> tool_events_seen;  ///< per anchor term: events copied so far
   std::string describe() const;
+  /// CSV: time, tool, force (N), anchors, max_stretch (m), one row per tool and step.
+  void write_tool_log(const std::string& path) const;
 };
 
 /// Simulates `scene` (read and checked by read_scene_description and
