@@ -464,7 +464,9 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
       if (o.model_index >= 0 && !sim.state(o.model_index).bones[0].matrix().allFinite())
         fail(sc.path, ": object '", o.desc->name, "' became non-finite at step ", k + 1, " (t = ", t, " s)");
     // Contact figures from the terms' reports.
+    for (SceneContactStats::Pair& p : st.pairs) p.last_force.setZero();  // inactive terms report nothing
     for (const TermQuantityReport& q : rep.quantities) {
+      if (q.term.rfind("anchor:", 0) == 0) continue;  // tools' anchors: in tool_steps
       const auto key = std::make_pair(q.term, q.body);
       auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
       if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});

@@ -48,7 +48,8 @@ void expect_scene_error(const std::string& text, std::initializer_list<std::stri
 
 TEST(SceneDescription, ExampleScenesParse) {
   SceneFolder folder;
-  for (const char* name : {"ball_at_belly.yaml", "fall_on_floor.yaml", "box_press.yaml", "two_walkers.yaml"}) {
+  for (const char* name :
+       {"ball_at_belly.yaml", "fall_on_floor.yaml", "box_press.yaml", "two_walkers.yaml", "pinch_belly.yaml"}) {
     // Next to a placeholder avatar.h5, as the scenes' comments ask.
     const fs::path src = fs::path(test::source_dir()) / "apps" / "scenes" / name;
     const std::string copy = folder.file(name);
