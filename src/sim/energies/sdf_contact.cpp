@@ -195,10 +195,11 @@ void SdfContactTerm::add_normal_derivatives(const Configuration& q, const DofLay
   const PosedPoints::Rows r = samples_.rows(p);
   const Vec3 y = samples_.unposed_displaced(p, q.z);
   Mat3 A = Mat3::Zero();
-  std::array<Eigen::Matrix<double, 6, 1>, 8> gb;  // bones per point are few (≤ 4 in SMPL skinning; checked)
-  std::array<int, 8> ob_bone;
+  constexpr int kMaxBones = 24;  // SMPL's skeleton; a skin point has a few with weight
+  std::array<Eigen::Matrix<double, 6, 1>, kMaxBones> gb;
+  std::array<int, kMaxBones> ob_bone;
   const int nb = L.bones_dynamic ? r.num_bones : 0;
-  require(nb <= 8, name(), ": a skin sample has ", nb, " bones, at most 8 are supported");
+  require(nb <= kMaxBones, name(), ": a skin sample has ", nb, " bones, at most ", kMaxBones, " are supported");
   for (int e = 0; e < r.num_bones; ++e) {
     const Isometry& G = q.bones[r.bones[e]];
     const double w = r.bone_weights[e];
