@@ -4,9 +4,10 @@
 // builds simulation objects; the runtime turns a SceneDescription into its
 // model and state.
 //
-// Top-level keys follow DESIGN.md §5b (bodies, objects, contact, solver,
-// output; `tools` is not read yet). Coordinates are the avatar's frame, Y up,
-// facing +Z: the built-in avatar stands on y = 0 (soles at y = -0.01 m, pelvis
+// Top-level keys follow DESIGN.md §5b (bodies, objects, tools, contact,
+// solver, output; a tool's pose comes from keyframes or a pose file, live
+// streams are not read yet; tools touch every body, whatever `pairs` says).
+// Coordinates are the avatar's frame, Y up, facing +Z: the built-in avatar stands on y = 0 (soles at y = -0.01 m, pelvis
 // at 0.94 m, belly front near z = 0.11 m at y = 1.05 m).
 //
 // Example (every key shown; defaults in the comments, "required" where there is none):
