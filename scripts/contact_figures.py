@@ -55,6 +55,9 @@ def main():
     scenes = {}
     for folder in ("apps/scenes", "apps/scenes/figures"):
         for f in sorted(os.listdir(os.path.join(ROOT, folder))):
+            if f.endswith(".csv"):
+                shutil.copy(os.path.join(ROOT, folder, f), work)
+        for f in sorted(os.listdir(os.path.join(ROOT, folder))):
             if f.endswith(".yaml"):
                 shutil.copy(os.path.join(ROOT, folder, f), work)
                 log, secs = run([SFLSH, "simulate", f], work)
@@ -103,6 +106,24 @@ def main():
     m = re.search(r"linear momentum: start ([\d.]+) kg m/s, end ([\d.]+) kg m/s \(change (\S+)\)", log)
     rel = float(m[3]) / float(m[1])
     row("two-body collision, gravity off: |Δp| / |p|", "≤ 1e-6", f"{rel:.1e}", rel <= 1e-6, "figures/momentum_bump.yaml")
+    # Pinch-and-lift from a recorded pose file (issue 11).
+    log = scenes["pinch_from_file"][0]
+    m = re.search(r"tools: peak force ([\d.]+) N, largest anchor stretch ([\d.]+) mm", log)
+    grasps = len(re.findall(r": grasp (\d+) skin points", log))
+    releases = len(re.findall(r": release (\d+) skin points", log))
+    acc, damped, rej, _ = steps_line(log)
+    with h5py.File(os.path.join(work, "pinch_from_file.h5")) as h:
+        finite = bool(np.isfinite(h["/frames/positions"][:]).all())
+        u = h["/frames/displacement"][:]
+    stretch = float(m[2])
+    row("pinch-and-lift 1.5 cm from a pose file: largest anchor stretch (slip)", "≤ 1 mm", f"{stretch:.2f} mm",
+        stretch <= 1.0, "figures/pinch_from_file.yaml")
+    row("  … grasp / release events, rejected steps, NaN", "1 / 1, 0, none",
+        f"{grasps} / {releases}, {rej}, {'none' if finite else 'NaN'}", grasps == 1 and releases == 1 and rej == 0 and
+        finite, "figures/pinch_from_file.yaml")
+    row("  … peak force on the gripper; skin displacement at the end vs before the grasp", "(record)",
+        f"{float(m[1]):.0f} N; {np.abs(u[-1]).max() * 1e3:.1f} mm vs {np.abs(u[int(0.2 * 30)]).max() * 1e3:.1f} mm",
+        True, "figures/pinch_from_file.yaml")
     # The other examples, for the record.
     for name, term in (("ball_at_belly", "contact:ball"), ("box_press", "contact:press")):
         log = scenes[name][0]
@@ -111,7 +132,7 @@ def main():
         rows.append(f"| {name}: max penetration, peak force, step median | (record) | {pen:.2f} mm, {fmax:.0f} N, "
                     f"{med:.2f} ms | | `{name}.yaml` |")
 
-    print("# Contact figures (issue 10)\n")
+    print("# Contact and tool figures (issues 10 and 11)\n")
     print("Built-in avatar (`sflsh precompute --out avatar.h5`), default contact settings "
           "(stiffness 2e5 N/m per skin sample, 1e6 N/m per capsule pair, friction 0.5).")
     print("Reproduce: `/usr/bin/python3 scripts/contact_figures.py` (about two minutes after the build).\n")

@@ -275,6 +275,21 @@ tools:
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 1 + int(stats.tool_steps.size()));
   EXPECT_EQ(int(stats.tool_steps.size()), 96);
+  // The same gripper from a recorded pose file: the same run, bit for bit.
+  std::ofstream((dir_ / "pinch.csv").string()) << "time,x,y,z,qw,qx,qy,qz,closure\n"
+                                                  "0.0,0.001,0.035,0.002,1,0,0,0,1.0\n"
+                                                  "0.1,0.001,0.035,0.002,1,0,0,0,0.0\n"
+                                                  "0.4,0.001,0.040,0.002,1,0,0,0,0.0\n"
+                                                  "0.55,0.001,0.040,0.002,1,0,0,0,0.0\n"
+                                                  "0.6,0.001,0.040,0.002,1,0,0,0,1.0\n";
+  SceneDescription from_file = sc;
+  from_file.tools[0].keyframes.clear();
+  from_file.tools[0].pose_file = (dir_ / "pinch.csv").string();
+  SceneContactStats stats2;
+  const SimulationResult res2 = run_scene(from_file, opt, &stats2);
+  ASSERT_EQ(stats2.tool_events.size(), stats.tool_events.size());
+  ASSERT_EQ(res2.frame_positions.size(), res.frame_positions.size());
+  EXPECT_EQ(res2.frame_positions.back(), res.frame_positions.back());
 }
 
 TEST_F(SceneRun, CliRunsASceneFileAndRefusesOneAvatarFlagsWithIt) {
