@@ -82,8 +82,18 @@ struct SceneTool {
   RigidObjectModel shape;  ///< when desc->has_shape
   std::vector<GraspController> grasps;  ///< per body (when the tool has sensors)
   std::vector<std::string> anchor_keys;  ///< per body: the anchor term's tool name
-  size_t logged_events = 0;
+  std::string contact_term;              ///< "contact:<tool>": its contact terms' name
+  std::string anchor_prefix;             ///< "anchor:<tool>@": its anchor terms' names start so
 };
+
+/// The world frame at t + h from the poses at t and t + h (twist by finite difference).
+WorldFrame frame_between(const Isometry& before, const Isometry& after, double h) {
+  WorldFrame f;
+  f.pose = after;
+  f.linear_velocity = (after.translation() - before.translation()) / h;
+  f.angular_velocity = rotation_log(after.linear() * before.linear().transpose()) / h;
+  return f;
+}
 
 PoseTrack tool_track(const ToolDescription& t) {
   if (!t.pose_file.empty()) return PoseTrack(teleop::read_pose_file(t.pose_file), t.pose_file);
@@ -257,6 +267,8 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
   for (size_t i = 0; i < sc.tools.size(); ++i) {
     SceneTool& t = tools[i];
     t.desc = &sc.tools[i];
+    t.contact_term = "contact:" + t.desc->name;
+    t.anchor_prefix = "anchor:" + t.desc->name + "@";
     try {
       t.track = std::make_unique<PoseTrack>(tool_track(*t.desc));
     } catch (const Error& e) {
@@ -415,30 +427,24 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     }
     for (const SceneObject& o : objects) {
       if (o.model_index >= 0) continue;
-      WorldFrame& f = in.frames[o.desc->name];
-      f.pose = object_pose_at(*o.desc, t);
-      const Isometry before = object_pose_at(*o.desc, t - h);
-      f.linear_velocity = (f.pose.translation() - before.translation()) / h;
-      f.angular_velocity = rotation_log(f.pose.linear() * before.linear().transpose()) / h;
+      in.frames[o.desc->name] = frame_between(object_pose_at(*o.desc, t - h), object_pose_at(*o.desc, t), h);
     }
     for (SceneTool& tl : tools) {
-      const PoseSample now = tl.track->at(t - h), then = tl.track->at(t);
-      WorldFrame f;
-      f.pose = sample_pose(then);
+      const PoseSample now = tl.track->at(t - h);
       const Isometry before = sample_pose(now);
-      f.linear_velocity = (f.pose.translation() - before.translation()) / h;
-      f.angular_velocity = rotation_log(f.pose.linear() * before.linear().transpose()) / h;
+      const WorldFrame f = frame_between(before, sample_pose(tl.track->at(t)), h);
       in.frames[tl.desc->name] = f;
       for (size_t bi = 0; bi < tl.grasps.size(); ++bi) {
+        GraspController& grasp = tl.grasps[bi];
         const SceneBody& b = bodies[bi];
-        tl.grasps[bi].update(t - h, before, now.closure, sim.posed_surface(b.model_index), b.avatar->surface_faces);
-        add_anchor_frames(tl.anchor_keys[bi], f, tl.grasps[bi].anchors(), false, in.frames);
-        for (; st.tool_events.size() < 100000 && tl.grasps[bi].log().size() > st.tool_events_seen[tl.anchor_keys[bi]];
-             ++st.tool_events_seen[tl.anchor_keys[bi]]) {
-          const GraspEvent& ev = tl.grasps[bi].log()[st.tool_events_seen[tl.anchor_keys[bi]]];
+        // The posed skin only while the jaws look for something to grasp.
+        const Points skin = grasp.seeking(now.closure) ? sim.posed_surface(b.model_index) : Points();
+        if (grasp.update(t - h, before, now.closure, skin, b.avatar->surface_faces)) {
+          const GraspEvent& ev = grasp.log().back();
           st.tool_events.push_back({ev.time, tl.desc->name, b.desc->name,
                                     ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
         }
+        add_anchor_frames(tl.anchor_keys[bi], f, grasp.anchors(), false, in.frames);
       }
     }
     const StepReport rep = sim.step(in);
@@ -447,8 +453,8 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     for (const SceneTool& tl : tools) {
       SceneContactStats::ToolStep ts{t, tl.desc->name};
       for (const TermQuantityReport& q : rep.quantities) {
-        const bool contact = q.term == "contact:" + tl.desc->name;
-        const bool anchor = q.term.rfind("anchor:" + tl.desc->name + "@", 0) == 0;
+        const bool contact = q.term == tl.contact_term;
+        const bool anchor = q.term.rfind(tl.anchor_prefix, 0) == 0;
         if ((contact || anchor) && q.name == "force" && q.value.size() == 3)
           ts.force -= Vec3(q.value[0], q.value[1], q.value[2]);
         if (anchor && q.name == "anchor_points") ts.anchors += int(q.value.size());

@@ -25,7 +25,6 @@
 //     bodies (skipped when both are kinematic), and one per body with
 //     self_contact; object–object contact is not modelled.
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -72,7 +71,6 @@ struct SceneContactStats {
     int points = 0;
   };
   std::vector<ToolEvent> tool_events;
-  std::map<std::string, size_t> tool_events_seen;  ///< per anchor term: events copied so far
   std::string describe() const;
   /// CSV: time, tool, force (N), anchors, max_stretch (m), one row per tool and step.
   void write_tool_log(const std::string& path) const;

@@ -45,6 +45,9 @@ class GraspController {
   /// The current anchors: skin vertex and offset in the jaw frame (m).
   const std::vector<Anchor>& anchors() const { return anchors_; }
   bool grasping() const { return !anchors_.empty(); }
+  /// Whether update() at this closure would cast the sensors (closed, nothing
+  /// held yet): only then does it read the skin (callers may pass an empty one otherwise).
+  bool seeking(double closure) const { return closure < options_.closure_threshold && anchors_.empty(); }
   const std::vector<GraspEvent>& log() const { return log_; }
   const GraspOptions& options() const { return options_; }
 
