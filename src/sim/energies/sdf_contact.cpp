@@ -180,76 +180,75 @@ double SdfContactTerm::compute(const StepContext& ctx, const Configuration& q, V
     E += 0.5 * k * d * d;
     if (!grad && !hess) continue;
     const Vec3 n = T.linear() * s.gradient;  // ∂φ/∂x, world
-    add_normal_derivatives(q, L, p, n, k * d, k, ob, x, grad, hess);
+    // φ's gradient is n at x, and the object's point there is x itself.
+    add_point_derivatives(q, L, p, k * d * n, k * n * n.transpose(), ob, x, grad, hess);
   }
   return E;
 }
 
-void SdfContactTerm::add_normal_derivatives(const Configuration& q, const DofLayout& L, int p, const Vec3& n,
-                                            double kd, double k, int ob, const Vec3& x, VecRef* grad,
-                                            MatRef* hess) const {
-  // ∂φ/∂δ = nᵀ J_p, by blocks (posed_points.hpp): bone j (if dynamic)
-  // (p_j × n, w_j n) with p_j = w_j G_j y; handle h: w_h Aᵀ n, A = Σ_j w_j R_j.
-  // The Gauss–Newton Hessian k (∂φ/∂δ)ᵀ(∂φ/∂δ) is written block by block
-  // (fixed-size 6x6, 6x3, 3x3), so its cost is (6 n_b + 3 n_h)² without indirection.
-  const PosedPoints::Rows r = samples_.rows(p);
-  const Vec3 y = samples_.unposed_displaced(p, q.z);
-  Mat3 A = Mat3::Zero();
+void SdfContactTerm::add_point_derivatives(const Configuration& q, const DofLayout& L, int p, const Vec3& g,
+                                           const Mat3& H, int ob, const Vec3& y, VecRef* grad, MatRef* hess) const {
+  // r = x_p(q) − y(q_object): ∂r/∂δ = [J_p | −J_o], by blocks (posed_points.hpp):
+  // bone j (if dynamic) [−[p_j]×, w_j I] with p_j = w_j G_j ȳ (ȳ = x̄ + U z),
+  // handle h: w_h A with A = Σ_j w_j R_j, and the object's point
+  // J_o = [−[y]×, I] (it moves by ω × y + v). Adds Jᵀg and JᵀHJ block by block
+  // (fixed-size 6x6, 6x3, 3x3), so the cost is (6 n_b + 3 n_h)² without indirection.
+  using Mat36 = Eigen::Matrix<double, 3, 6>;
   constexpr int kMaxBones = 24;  // SMPL's skeleton; a skin point has a few with weight
-  std::array<Eigen::Matrix<double, 6, 1>, kMaxBones> gb;
-  std::array<int, kMaxBones> ob_bone;
+  const PosedPoints::Rows r = samples_.rows(p);
   const int nb = L.bones_dynamic ? r.num_bones : 0;
   require(nb <= kMaxBones, name(), ": a skin sample has ", nb, " bones, at most ", kMaxBones, " are supported");
+  const Vec3 yb = samples_.unposed_displaced(p, q.z);
+  std::array<Mat36, kMaxBones> Jb;
+  std::array<int, kMaxBones> col;
+  Mat3 A = Mat3::Zero();
   for (int e = 0; e < r.num_bones; ++e) {
     const Isometry& G = q.bones[r.bones[e]];
     const double w = r.bone_weights[e];
     A += w * G.linear();
     if (e < nb) {
-      gb[e].head<3>() = (w * (G * y)).cross(n);
-      gb[e].tail<3>() = w * n;
-      ob_bone[e] = L.bone_offset(r.bones[e]);
+      Jb[e] << -hat(w * (G * yb)), w * Mat3::Identity();
+      col[e] = L.bone_offset(r.bones[e]);
     }
   }
-  const Vec3 a = A.transpose() * n;
+  Mat36 Jo;
+  if (ob >= 0) Jo << -hat(y), Mat3::Identity();
   const int z0 = L.z_offset();
-  Eigen::Matrix<double, 6, 1> go = Eigen::Matrix<double, 6, 1>::Zero();  // ∂φ/∂ξ_object: a point of the object moves by ω × x + v
-  if (ob >= 0) {
-    go.head<3>() = -x.cross(n);
-    go.tail<3>() = -n;
-  }
   if (grad) {
-    for (int i = 0; i < nb; ++i) grad->segment<6>(ob_bone[i]) += kd * gb[i];
-    for (int h = 0; h < r.num_handles; ++h) grad->segment<3>(z0 + 3 * r.handles[h]) += (kd * r.handle_weights[h]) * a;
-    if (ob >= 0) grad->segment<6>(ob) += kd * go;
+    for (int i = 0; i < nb; ++i) grad->segment<6>(col[i]) += Jb[i].transpose() * g;
+    const Vec3 Atg = A.transpose() * g;
+    for (int h = 0; h < r.num_handles; ++h) grad->segment<3>(z0 + 3 * r.handles[h]) += r.handle_weights[h] * Atg;
+    if (ob >= 0) grad->segment<6>(ob) -= Jo.transpose() * g;
   }
   if (!hess) return;
-  const Mat3 aa = k * a * a.transpose();
+  const Mat3 HA = H * A, AHA = A.transpose() * HA;
+  const Mat36 HJo = H * Jo;
   for (int h = 0; h < r.num_handles; ++h) {
     const int zh = z0 + 3 * r.handles[h];
     const double wh = r.handle_weights[h];
     for (int l = 0; l < r.num_handles; ++l)
-      hess->block<3, 3>(zh, z0 + 3 * r.handles[l]) += (wh * r.handle_weights[l]) * aa;
-    const Vec3 ka = (k * wh) * a;
+      hess->block<3, 3>(zh, z0 + 3 * r.handles[l]) += (wh * r.handle_weights[l]) * AHA;
     for (int i = 0; i < nb; ++i) {
-      const Eigen::Matrix<double, 6, 3> c = gb[i] * ka.transpose();
-      hess->block<6, 3>(ob_bone[i], zh) += c;
-      hess->block<3, 6>(zh, ob_bone[i]) += c.transpose();
+      const Eigen::Matrix<double, 6, 3> c = wh * (Jb[i].transpose() * HA);
+      hess->block<6, 3>(col[i], zh) += c;
+      hess->block<3, 6>(zh, col[i]) += c.transpose();
     }
     if (ob >= 0) {
-      const Eigen::Matrix<double, 6, 3> c = go * ka.transpose();
+      const Eigen::Matrix<double, 6, 3> c = -wh * (Jo.transpose() * HA);
       hess->block<6, 3>(ob, zh) += c;
       hess->block<3, 6>(zh, ob) += c.transpose();
     }
   }
   for (int i = 0; i < nb; ++i) {
-    for (int j = 0; j < nb; ++j) hess->block<6, 6>(ob_bone[i], ob_bone[j]) += k * gb[i] * gb[j].transpose();
+    const Mat36 HJi = H * Jb[i];
+    for (int j = 0; j < nb; ++j) hess->block<6, 6>(col[j], col[i]) += Jb[j].transpose() * HJi;
     if (ob >= 0) {
-      const Eigen::Matrix<double, 6, 6> c = k * gb[i] * go.transpose();
-      hess->block<6, 6>(ob_bone[i], ob) += c;
-      hess->block<6, 6>(ob, ob_bone[i]) += c.transpose();
+      const Eigen::Matrix<double, 6, 6> c = -(Jo.transpose() * HJi);
+      hess->block<6, 6>(ob, col[i]) += c;
+      hess->block<6, 6>(col[i], ob) += c.transpose();
     }
   }
-  if (ob >= 0) hess->block<6, 6>(ob, ob) += k * go * go.transpose();
+  if (ob >= 0) hess->block<6, 6>(ob, ob) += Jo.transpose() * HJo;
 }
 
 double SdfContactTerm::friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda,
@@ -266,36 +265,8 @@ double SdfContactTerm::friction(const StepContext& ctx, const Configuration& q, 
   Mat3 Hs = (2 / eps) * Mat3::Identity();
   if (z > 0) Hs = (f1 / z) * Mat3::Identity() + (df1 - f1 / z) / (z * z) * s * s.transpose();
   Hs *= c;
-  const Mat3 H = P * Hs * P;
   const DofLayout& L = ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
-  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
-  std::vector<int> cols;
-  samples_.local_jacobian(p, q, L, J, cols);
-  const int m = int(cols.size());
-  const Eigen::Matrix<double, 3, Eigen::Dynamic> HJ = H * J;
-  // The object's point y moves by ω × y + v: ∂(x − y)/∂ξ_object = −[−[y]×, I].
-  Eigen::Matrix<double, 3, 6> Jy;
-  if (dynamic_) Jy << -hat(y), Mat3::Identity();
-  const int ob = dynamic_ ? ctx.bound[1].layout.base : -1;
-  if (grad) {
-    const VecX gb = J.transpose() * g;
-    for (int a = 0; a < m; ++a) (*grad)[cols[a]] += gb[a];
-    if (dynamic_) grad->segment<6>(ob) -= Jy.transpose() * g;
-  }
-  if (hess) {
-    const MatX Hbb = J.transpose() * HJ;
-    for (int a = 0; a < m; ++a)
-      for (int b = 0; b < m; ++b) (*hess)(cols[a], cols[b]) += Hbb(a, b);
-    if (dynamic_) {
-      hess->block<6, 6>(ob, ob) += Jy.transpose() * H * Jy;
-      const Eigen::Matrix<double, 6, Eigen::Dynamic> Hob = -(Jy.transpose() * HJ);
-      for (int a = 0; a < m; ++a)
-        for (int r = 0; r < 6; ++r) {
-          (*hess)(ob + r, cols[a]) += Hob(r, a);
-          (*hess)(cols[a], ob + r) += Hob(r, a);
-        }
-    }
-  }
+  add_point_derivatives(q, L, p, g, P * Hs * P, dynamic_ ? ctx.bound[1].layout.base : -1, y, grad, hess);
   return c * f0;
 }
 

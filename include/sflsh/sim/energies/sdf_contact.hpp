@@ -93,10 +93,11 @@ class SdfContactTerm : public EnergyTerm {
   /// carries the touched point; adds its gradient/Hessian.
   double friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda, const Vec3& n,
                   const Vec3& y, double mu, double eps, VecRef* grad, MatRef* hess) const;
-  /// Adds kd·∂φ/∂δ and k (∂φ/∂δ)ᵀ(∂φ/∂δ) of sample p (normal n, world point x)
-  /// to the body's columns (layout L) and the object's 6 (at `ob`, −1 = none).
-  void add_normal_derivatives(const Configuration& q, const DofLayout& L, int p, const Vec3& n, double kd, double k,
-                              int ob, const Vec3& x, VecRef* grad, MatRef* hess) const;
+  /// For a potential of r = x_p(q) − y(q_object) (sample p; y the object's
+  /// point, `ob` its 6 DoFs or −1): adds Jᵀg and JᵀHJ, J = ∂r/∂δ, to the
+  /// body's columns (layout L) and the object's, given g = ∂E/∂r and H ≈ ∂²E/∂r².
+  void add_point_derivatives(const Configuration& q, const DofLayout& L, int p, const Vec3& g, const Mat3& H, int ob,
+                             const Vec3& y, VecRef* grad, MatRef* hess) const;
   struct Cluster {
     int bone = 0;
     Vec3 center = Vec3::Zero();  ///< unposed, m
