@@ -157,6 +157,13 @@ TEST(SdfContact, GradientAndHessianAgainstAStaticSphereMatchFiniteDifferences) {
     ASSERT_TRUE(term.active(ctx));
     const Derivatives d = analytic(term, ctx, bodies);
     ASSERT_GT(d.E, 0);
+    // The value by hand: ½ k (r − |x − c|)² over the skin points inside the ball.
+    double by_hand = 0;
+    for (int p = 0; p < term.samples().size(); ++p) {
+      const double depth = 0.05 - (term.samples().world_point(p, bodies[0].q) - frames["ball"].pose.translation()).norm();
+      if (depth > 0) by_hand += 0.5 * k * depth * depth;
+    }
+    EXPECT_NEAR(d.E, by_hand, 1e-12 * by_hand);
     EXPECT_LT(rel(d.grad, fd_gradient(term, ctx, bodies, 1e-7)), 1e-6) << "bones dynamic " << dynamic;
     // Gauss–Newton: k Σ j jᵀ over the penetrating samples, j by finite differences of φ.
     const int n = total_size(bodies);
