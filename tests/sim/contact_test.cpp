@@ -301,6 +301,22 @@ TEST(SdfContact, FrictionDerivativesMatchFiniteDifferencesWhileStickingAndSlidin
     Vec3 sum = gf.segment<3>(bodies[1].layout.bone_offset(0) + 3);
     for (int j = 0; j < 24; ++j) sum += gf.segment<3>(bodies[0].layout.bone_offset(j) + 3);
     EXPECT_LT(sum.norm(), 1e-9 * gf.norm());
+    if (slip > 1e-4) {
+      // Sliding (slip ≫ ε): each skin point in the lid at t (λ_p = k·depth,
+      // normal n_p there) pulls the lid by μ λ_p along its tangential slip ŝ_p:
+      // ∂E/∂v_lid = −Σ μ λ_p ŝ_p.
+      Vec3 expected = Vec3::Zero();
+      for (int p = 0; p < with.samples().size(); ++p) {
+        const Vec3 x_t = with.samples().world_point(p, bodies[0].q_prev);
+        const geometry::SdfSample sd = cube->evaluate(G.inverse() * x_t);
+        if (sd.distance >= 0) continue;
+        const Vec3 n = G.linear() * sd.gradient;
+        const Vec3 s = (Mat3::Identity() - n * n.transpose()) * (with.samples().world_point(p, bodies[0].q) - x_t);
+        expected -= 0.6 * 2.0e4 * -sd.distance * s.normalized();
+      }
+      ASSERT_GT(expected.norm(), 0);
+      EXPECT_LT((gf.segment<3>(bodies[1].layout.bone_offset(0) + 3) - expected).norm(), 1e-6 * expected.norm());
+    }
   }
 }
 
