@@ -83,7 +83,8 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     // Contact figures from the terms' reports.
     for (SceneContactStats::Pair& p : st.pairs) p.last_force.setZero();  // inactive terms report nothing
     for (const TermQuantityReport& q : rep.quantities) {
-      if (q.term.rfind("anchor:", 0) == 0) continue;  // tools' anchors: in tool_steps
+      // Tools' anchors and couplings: in tool_steps.
+      if (q.term.rfind("anchor:", 0) == 0 || q.term.rfind("coupling:", 0) == 0) continue;
       const auto key = std::make_pair(q.term, q.body);
       auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
       if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});

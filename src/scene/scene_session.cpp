@@ -1,6 +1,7 @@
 #include "sflsh/scene/scene_session.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <map>
 
@@ -14,17 +15,21 @@
 #include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energies/capsule_contact.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/sim/energies/virtual_coupling.hpp"
 #include "sflsh/sim/grasp_controller.hpp"
 #include "sflsh/sim/rigid_body_terms.hpp"
 #include "sflsh/sim/skeleton_terms.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sflsh/teleop/pose_file.hpp"
+#include "sflsh/teleop/pose_recorder.hpp"
+#include "sflsh/teleop/pose_stream_link.hpp"
 #include "sflsh/teleop/pose_track.hpp"
 
 namespace sflsh {
 namespace {
 
 using teleop::PoseSample;
+using teleop::PoseInterpolation;
 using teleop::PoseTrack;
 
 /// A body of the scene as the run drives it.
@@ -76,6 +81,7 @@ WorldFrame frame_between(const Isometry& before, const Isometry& after, double h
 
 PoseTrack tool_track(const ToolDescription& t) {
   if (!t.pose_file.empty()) return PoseTrack(teleop::read_pose_file(t.pose_file), t.pose_file);
+  if (t.keyframes.empty()) return PoseTrack({PoseSample{}}, "tool '" + t.name + "' start pose");
   std::vector<PoseSample> samples;
   for (const ToolKeyframe& k : t.keyframes) samples.push_back({k.time, k.position, k.orientation, k.closure});
   return PoseTrack(std::move(samples), "tool '" + t.name + "' keyframes");
@@ -115,13 +121,32 @@ struct SceneTool {
   std::vector<std::string> anchor_keys;  ///< per body: the anchor term's tool name
   std::string contact_term;              ///< "contact:<tool>": its contact terms' name
   std::string anchor_prefix;             ///< "anchor:<tool>@": its anchor terms' names start so
+  bool hold = false;  ///< the track is a recording: zero-order hold
   /// The device sample at the current time, and the pushed one for the next
   /// step (live tools).
   PoseSample device_now;
   bool live = false;
   PoseSample pushed;
+  std::unique_ptr<teleop::PoseStreamLink> link;  ///< a live stream (pose_stream)
+  std::uint64_t link_sequence = 0;               ///< the newest stream sample taken
+  bool link_seen = false;
+  int model_index = -1;  ///< coupled tools: their rigid body in the model
+  VirtualCouplingOptions coupling;
+  std::unique_ptr<teleop::PoseRecorder> recorder;  ///< --record: the device poses used
+  PoseSample recorded;
   SceneToolState state;
+
+  /// Whether state.pose is the pose to draw (else the linear track at t, as before sessions).
+  bool exact_pose() const { return live || hold || model_index >= 0; }
+  /// The tool's body pose at the current time (coupled) or its device's.
+  Isometry pose(const Simulator& sim) const {
+    return model_index >= 0 ? sim.state(model_index).bones[0] : sample_pose(device_now);
+  }
 };
+
+bool same_sample(const PoseSample& a, const PoseSample& b) {
+  return a.position == b.position && a.orientation.coeffs() == b.orientation.coeffs() && a.closure == b.closure;
+}
 
 }  // namespace
 
@@ -247,10 +272,47 @@ void SceneSession::Impl::build() {
     t.contact_term = "contact:" + t.desc->name;
     t.anchor_prefix = "anchor:" + t.desc->name + "@";
     try {
-      t.track = std::make_unique<PoseTrack>(tool_track(*t.desc));
+      if (!opt.replay_dir.empty()) {
+        const std::string file = (std::filesystem::path(opt.replay_dir) / (t.desc->name + ".csv")).string();
+        t.track = std::make_unique<PoseTrack>(teleop::read_pose_file(file), file);
+        t.hold = true;
+      } else {
+        t.track = std::make_unique<PoseTrack>(tool_track(*t.desc));
+        t.hold = t.desc->pose_file_hold;
+      }
     } catch (const Error& e) {
       fail(sc.path, ": tools '", t.desc->name, "': ", e.what());
     }
+    if (t.desc->stream_port >= 0 && opt.open_streams && opt.replay_dir.empty()) {
+      teleop::PoseStreamServerOptions so;
+      so.port = t.desc->stream_port;
+      so.checks.max_speed = t.desc->stream_max_speed;
+      const std::string tool_name = t.desc->name;
+      so.log = [tool_name](const std::string& line) { std::cerr << "tool " << tool_name << ": " << line << "\n"; };
+      try {
+        t.link = std::make_unique<teleop::PoseStreamLink>(so);
+      } catch (const Error& e) {
+        fail(sc.path, ": tools '", t.desc->name, "': pose_stream: ", e.what());
+      }
+      if (opt.progress)
+        std::cerr << "tool " << t.desc->name << ": listening for device poses on udp://127.0.0.1:" << t.link->port()
+                  << "\n";
+    }
+    if (t.desc->coupled) {
+      const ToolCouplingDescription& cd = t.desc->coupling;
+      // The tool body: a solid sphere of radius 2 cm of the coupling's mass
+      // about the tool frame's origin (only its dynamics use it).
+      const double inertia = 0.4 * cd.mass * 0.02 * 0.02;
+      t.model_index = mb.add_body({t.desc->name, nullptr, true});
+      add_rigid_body_terms(mb, t.model_index, cd.mass, inertia * Mat3::Identity(), false);
+      t.coupling.stiffness = cd.stiffness;
+      t.coupling.rotational_stiffness = cd.rotational_stiffness;
+      t.coupling.damping = cd.damping >= 0 ? cd.damping : 2.0 * std::sqrt(cd.stiffness * cd.mass);
+      t.coupling.rotational_damping =
+          cd.rotational_damping >= 0 ? cd.rotational_damping : 2.0 * std::sqrt(cd.rotational_stiffness * inertia);
+      mb.add_term(std::make_shared<const VirtualCouplingTerm>(t.desc->name, t.coupling), {t.model_index});
+    }
+    const bool coupled = t.model_index >= 0;
     if (t.desc->has_shape) {
       RigidObjectDescription as_object;
       as_object.name = t.desc->name;
@@ -265,9 +327,13 @@ void SceneSession::Impl::build() {
         SdfContactOptions co;
         co.stiffness = c.body_object_stiffness;
         co.friction = c.friction;
-        mb.add_term(std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
-                                                           false, co),
-                    {b.model_index});
+        auto term = std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
+                                                           coupled, co);
+        if (coupled) {
+          mb.add_term(term, {b.model_index, t.model_index});
+        } else {
+          mb.add_term(term, {b.model_index});
+        }
       }
       if (!t.desc->sensors.empty()) {
         GraspOptions go;
@@ -275,9 +341,13 @@ void SceneSession::Impl::build() {
         go.closure_threshold = t.desc->closure_threshold;
         t.grasps.emplace_back(go);
         t.anchor_keys.push_back(t.desc->name + "@" + b.desc->name);
-        mb.add_term(std::make_shared<const AnchorTerm>(t.anchor_keys.back(), PosedPoints::at_surface(*b.avatar), false,
-                                                       AnchorOptions{t.desc->hardness, t.desc->damping}),
-                    {b.model_index});
+        auto term = std::make_shared<const AnchorTerm>(t.anchor_keys.back(), PosedPoints::at_surface(*b.avatar),
+                                                       coupled, AnchorOptions{t.desc->hardness, t.desc->damping});
+        if (coupled) {
+          mb.add_term(term, {b.model_index, t.model_index});
+        } else {
+          mb.add_term(term, {b.model_index});
+        }
       }
     }
   }
@@ -313,14 +383,21 @@ void SceneSession::Impl::build() {
       G_prev.linear() = Eigen::AngleAxisd(-w * h, o.desc->angular_velocity / w).toRotationMatrix() * G.linear();
     s.bodies[o.model_index] = {Configuration{{G}, VecX(0)}, Configuration{{G_prev}, VecX(0)}};
   }
-  sim->set_state(s);
-
-  in.bodies.resize(sim->model().bodies().size());
   for (SceneTool& t : tools) {
-    t.device_now = t.track->at(0.0);
+    t.device_now = t.track->at(0.0, t.hold ? PoseInterpolation::kHold : PoseInterpolation::kLinear);
     t.state.device = t.device_now;
     t.state.pose = sample_pose(t.device_now);
+    if (t.model_index >= 0)
+      s.bodies[t.model_index] = {Configuration{{t.state.pose}, VecX(0)}, Configuration{{t.state.pose}, VecX(0)}};
+    if (!opt.record_dir.empty()) {
+      t.recorder = std::make_unique<teleop::PoseRecorder>(
+          (std::filesystem::path(opt.record_dir) / (t.desc->name + ".csv")).string());
+      t.recorder->record({0, t.device_now, 0.0});
+      t.recorded = t.device_now;
+    }
   }
+  sim->set_state(s);
+  in.bodies.resize(sim->model().bodies().size());
 }
 
 SceneSession::SceneSession(const SceneDescription& scene, const SceneSessionOptions& options)
@@ -359,12 +436,28 @@ const StepReport& SceneSession::advance() {
     in.frames[o.desc->name] = frame_between(object_pose_at(*o.desc, t - h), object_pose_at(*o.desc, t), h);
   }
   for (SceneTool& tl : m.tools) {
-    // The device at t (the grasp looks from there) and at t + h (where the step takes the tool).
-    const PoseSample now = tl.live ? tl.device_now : tl.track->at(t - h);
-    const PoseSample next = tl.live ? tl.pushed : tl.track->at(t);
-    const Isometry before = sample_pose(now);
-    const WorldFrame f = frame_between(before, sample_pose(next), h);
-    in.frames[tl.desc->name] = f;
+    if (tl.link) {
+      // The newest good sample of the live stream (held when none came).
+      if (const auto got = tl.link->latest(); got && (!tl.link_seen || got->sequence != tl.link_sequence)) {
+        tl.link_seen = true;
+        tl.link_sequence = got->sequence;
+        tl.pushed = got->sample;
+        tl.live = true;
+      }
+    }
+    // The device at t (the grasp looks from there) and at t + h (where the
+    // step takes the tool). Keyframes and pose files are interpolated at both
+    // times; live and recorded devices step from the pose held at t.
+    const bool linear = !tl.live && !tl.hold;
+    const PoseSample now = linear ? tl.track->at(t - h) : tl.device_now;
+    const PoseSample next = tl.live ? tl.pushed : linear ? tl.track->at(t) : tl.track->at(t, PoseInterpolation::kHold);
+    const WorldFrame f = frame_between(sample_pose(now), sample_pose(next), h);
+    const bool coupled = tl.model_index >= 0;
+    in.frames[coupled ? device_frame_name(tl.desc->name) : tl.desc->name] = f;
+    // Where the jaws are at t: the coupled body, or the device.
+    WorldFrame jaws = f;
+    if (coupled) jaws = WorldFrame{sim.state(tl.model_index).bones[0]};
+    const Isometry before = coupled ? jaws.pose : sample_pose(now);
     for (size_t bi = 0; bi < tl.grasps.size(); ++bi) {
       GraspController& grasp = tl.grasps[bi];
       const SceneBody& b = m.bodies[bi];
@@ -375,11 +468,14 @@ const StepReport& SceneSession::advance() {
         m.events.push_back({ev.time, tl.desc->name, b.desc->name,
                             ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
       }
-      add_anchor_frames(tl.anchor_keys[bi], f, grasp.anchors(), false, in.frames);
+      add_anchor_frames(tl.anchor_keys[bi], jaws, grasp.anchors(), coupled, in.frames);
+    }
+    if (tl.recorder && !same_sample(next, tl.recorded)) {
+      tl.recorder->record({0, next, t});
+      tl.recorded = next;
     }
     tl.device_now = next;
     tl.state.device = next;
-    tl.state.pose = sample_pose(next);
   }
   m.report = sim.step(in);
   m.k = k + 1;
@@ -400,9 +496,25 @@ const StepReport& SceneSession::advance() {
       if (anchor && q.name == "anchor_points") ts.anchors += int(q.value.size());
       if (anchor && q.name == "max_stretch") ts.max_stretch = std::max(ts.max_stretch, q.value[0]);
     }
-    ts.feedback_force = ts.force;
-    ts.feedback_torque = ts.torque;
     ts.live = tl.live;
+    ts.pose = tl.pose(sim);
+    if (tl.model_index >= 0) {
+      // The device feels the coupling's pull, opposite to its force on the tool.
+      const std::string name = "coupling:" + tl.desc->name;
+      for (const TermQuantityReport& q : rep.quantities) {
+        if (q.term != name) continue;
+        if (q.name == "force") ts.feedback_force = -Vec3(q.value[0], q.value[1], q.value[2]);
+        if (q.name == "torque") ts.feedback_torque = -Vec3(q.value[0], q.value[1], q.value[2]);
+      }
+    } else {
+      ts.feedback_force = ts.force;
+      ts.feedback_torque = ts.torque;
+    }
+    const ToolCouplingDescription& cd = tl.desc->coupling;
+    ts.feedback_force *= cd.haptic_gain;
+    ts.feedback_torque *= cd.haptic_gain;
+    if (ts.feedback_force.norm() > cd.max_force) ts.feedback_force *= cd.max_force / ts.feedback_force.norm();
+    if (tl.link) tl.link->publish(ts.feedback_force, ts.feedback_torque, t);
   }
   for (const SceneBody& b : m.bodies)
     if (!sim.state(b.model_index).z.allFinite() || !sim.state(b.model_index).bones[0].matrix().allFinite())
@@ -411,6 +523,9 @@ const StepReport& SceneSession::advance() {
   for (const SceneObject& o : m.objects)
     if (o.model_index >= 0 && !sim.state(o.model_index).bones[0].matrix().allFinite())
       fail(m.sc.path, ": object '", o.desc->name, "' became non-finite at step ", k + 1, " (t = ", t, " s)");
+  for (const SceneTool& tl : m.tools)
+    if (!tl.state.pose.matrix().allFinite())
+      fail(m.sc.path, ": tool '", tl.desc->name, "' became non-finite at step ", k + 1, " (t = ", t, " s)");
   return rep;
 }
 
@@ -447,7 +562,27 @@ void SceneSession::set_device_pose(int tool, const PoseSample& sample) {
   t.live = true;
 }
 
-int SceneSession::stream_port(int) const { return 0; }
+int SceneSession::stream_port(int tool) const {
+  const SceneTool& t = impl_->tools.at(tool);
+  return t.link ? t.link->port() : 0;
+}
+
+std::string SceneSession::stream_counters(int tool) const {
+  const SceneTool& t = impl_->tools.at(tool);
+  if (!t.link) return "";
+  return t.link->counters().describe() + ", feedback sent " + std::to_string(t.link->feedback_sent());
+}
+
+std::vector<std::string> SceneSession::finish_recording() {
+  std::vector<std::string> paths;
+  for (SceneTool& t : impl_->tools)
+    if (t.recorder) {
+      t.recorder->finish();
+      paths.push_back(t.recorder->path());
+      t.recorder.reset();
+    }
+  return paths;
+}
 
 SimulationResult SceneSession::result_header() const {
   const Impl& m = *impl_;
@@ -481,7 +616,8 @@ SimulationResult SceneSession::result_header() const {
                          o.model.surface.vertices, o.model.surface.faces, {}});
   for (const SceneTool& t : m.tools)
     if (t.desc->has_shape)
-      r.objects.push_back({t.desc->name, shape_type_name(t.desc->shape.type), "kinematic", t.shape.surface.vertices,
+      r.objects.push_back({t.desc->name, shape_type_name(t.desc->shape.type),
+                           t.model_index >= 0 ? "dynamic" : "kinematic", t.shape.surface.vertices,
                            t.shape.surface.faces, {}});
   return r;
 }
@@ -492,7 +628,7 @@ std::vector<Isometry> SceneSession::object_poses() const {
   std::vector<Isometry> poses;
   for (const SceneObject& o : m.objects) poses.push_back(m.object_pose(o, t));
   for (const SceneTool& tl : m.tools)
-    if (tl.desc->has_shape) poses.push_back(tl.live ? tl.state.pose : sample_pose(tl.track->at(t)));
+    if (tl.desc->has_shape) poses.push_back(tl.exact_pose() ? tl.state.pose : sample_pose(tl.track->at(t)));
   return poses;
 }
 
@@ -524,7 +660,7 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
   for (size_t i = 0; i < m.objects.size(); ++i) r.objects[i].poses.push_back(m.object_pose(m.objects[i], t));
   size_t next = m.objects.size();
   for (const SceneTool& tl : m.tools)
-    if (tl.desc->has_shape) r.objects[next++].poses.push_back(tl.live ? tl.state.pose : sample_pose(tl.track->at(t)));
+    if (tl.desc->has_shape) r.objects[next++].poses.push_back(tl.exact_pose() ? tl.state.pose : sample_pose(tl.track->at(t)));
   ++r.num_frames;
 }
 

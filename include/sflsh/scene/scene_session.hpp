@@ -53,6 +53,14 @@ struct SceneSessionOptions {
   /// their keyframe pose unless poses are pushed with set_device_pose; for
   /// offline checks of a live scene).
   bool open_streams = true;
+  /// Record the device poses each tool's steps used into DIR/<tool>.csv
+  /// (teleop/pose_recorder.hpp; "" = no recording). finish_recording() puts
+  /// the files in place.
+  std::string record_dir;
+  /// Replay a recording: every tool follows DIR/<tool>.csv with zero-order
+  /// hold instead of its own pose source (its stream is not opened). Replaying
+  /// a recorded session gives bit-identical trajectories.
+  std::string replay_dir;
 };
 
 /// A tool after the latest step.
@@ -132,6 +140,11 @@ class SceneSession {
   void set_device_pose(int tool, const teleop::PoseSample& sample);
   /// The UDP port of a tool's pose stream (0 when it has none or streams are closed).
   int stream_port(int tool) const;
+  /// Closes the recording (record_dir) and renames its files into place;
+  /// returns their paths. Without it the recording leaves nothing behind.
+  std::vector<std::string> finish_recording();
+  /// Stream counters of a tool's live stream ("" when it has none).
+  std::string stream_counters(int tool) const;
   /// Grasp and release events so far.
   const std::vector<SceneToolEvent>& tool_events() const;
 
