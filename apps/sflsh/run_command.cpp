@@ -15,6 +15,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/line_plot_svg.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/scene/live_run.hpp"
 #include "sflsh/scene/result_file.hpp"
@@ -45,6 +46,8 @@ class ToolLog {
           << std::setprecision(9);
   }
   void add(const SceneSession& s, const StepReport& rep) {
+    if (force_.empty()) force_.resize(size_t(s.num_tools())), feedback_.resize(size_t(s.num_tools()));
+    time_.push_back(s.time());
     double elastic = 0;
     for (const TermEnergy& e : rep.energies)
       if (e.name.rfind("elastic", 0) == 0) elastic += e.value;
@@ -56,7 +59,20 @@ class ToolLog {
             << t.feedback_force.x() << "," << t.feedback_force.y() << "," << t.feedback_force.z() << ","
             << t.anchors << "," << t.max_stretch << "," << t.device.closure << "," << elastic << ","
             << to_string(rep.outcome) << "\n";
+      force_[size_t(i)].push_back(t.force.norm());
+      feedback_[size_t(i)].push_back(t.feedback_force.norm());
+      names_.resize(size_t(s.num_tools()));
+      names_[size_t(i)] = s.tool_name(i);
     }
+  }
+  /// A plot of |force| and |feedback| per tool against time.
+  void plot(const std::string& path) const {
+    std::vector<io::PlotSeries> series;
+    for (size_t i = 0; i < force_.size(); ++i) {
+      series.push_back({names_[i] + ": force from the bodies", time_, force_[i], io::plot_color(int(2 * i)), false});
+      series.push_back({names_[i] + ": sent to the device", time_, feedback_[i], io::plot_color(int(2 * i + 1)), true});
+    }
+    io::write_line_plot_svg(path, "Force on the tools per step", "time (s)", "|force| (N)", series);
   }
   void commit() {
     file_.close();
@@ -67,6 +83,9 @@ class ToolLog {
  private:
   io::AtomicOutput out_;
   std::ofstream file_;
+  std::vector<double> time_;
+  std::vector<std::vector<double>> force_, feedback_;
+  std::vector<std::string> names_;
 };
 
 void run_scene_live(const RunArgs& a) {
@@ -130,7 +149,10 @@ void run_scene_live(const RunArgs& a) {
   for (const std::string& p : session.finish_recording()) std::printf("recorded the device poses to %s\n", p.c_str());
   if (log) {
     log->commit();
-    std::printf("wrote %s (tools per step)\n", a.tool_log.c_str());
+    const std::filesystem::path p(a.tool_log);
+    const std::string svg = (p.parent_path() / (p.stem().string() + ".svg")).string();
+    log->plot(svg);
+    std::printf("wrote %s (tools per step) and %s (plot)\n", a.tool_log.c_str(), svg.c_str());
   }
   if (!a.out.empty()) {
     write_simulation_result(result, a.out);

@@ -57,8 +57,9 @@ std::string LiveRunStatus::describe(bool realtime) const {
     o << buf;
   }
   if (!step_ms.empty()) {
-    std::snprintf(buf, sizeof buf, "\nstep time: median %.3f ms, p99 %.3f ms, max %.3f ms",
-                  percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0));
+    std::snprintf(buf, sizeof buf, "\nsteps: %ld accepted, %ld damped, %ld rejected; step time median %.3f ms, p99 %.3f ms, max %.3f ms",
+                  steps - damped - rejected, damped, rejected, percentile(step_ms, 0.5), percentile(step_ms, 0.99),
+                  percentile(step_ms, 1.0));
     o << buf;
   }
   if (interrupted) o << "\nended by a signal";
@@ -79,6 +80,8 @@ LiveRunStatus run_live(SceneSession& s, const LiveRunOptions& opt, const LiveRun
     const StepReport& rep = s.advance();
     st.step_ms.push_back((wall_seconds() - t0) * 1e3);
     ++st.steps;
+    if (rep.outcome == StepOutcome::Damped) ++st.damped;
+    if (rep.outcome == StepOutcome::Rejected) ++st.rejected;
     if (hooks.after_step) hooks.after_step(s, rep);
   };
   auto end_frame = [&] {

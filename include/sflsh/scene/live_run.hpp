@@ -44,6 +44,7 @@ struct LiveRunHooks {
 /// Where a live run stands.
 struct LiveRunStatus {
   long steps = 0;
+  long damped = 0, rejected = 0;  ///< steps whose worst Newton iteration was damped / rejected
   long frames = 0;
   long frames_behind = 0;       ///< real time: frames clamped at max_substeps
   double sim_time = 0;          ///< s simulated in this run
