@@ -300,7 +300,8 @@ RigidObjectDescription parse_object(const SceneParser& p, const YAML::Node& n, c
 }
 
 ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std::string& key) {
-  p.check_map(n, key, {"name", "shape", "keyframes", "pose_file", "pose_interpolation", "pose_stream", "coupling", "grasp"},
+  p.check_map(n, key, {"name", "shape", "keyframes", "pose_file", "pose_interpolation", "pose_stream", "coupling", "gripper",
+               "grasp"},
               "a tool");
   auto k = [&](const std::string& c) { return SceneParser::child_key(key, c); };
   ToolDescription t;
@@ -367,6 +368,33 @@ ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std:
       if (i > 0 && f.time <= t.keyframes.back().time)
         p.error(kf[i], ik + ".time", "keyframe times must increase, got ", f.time, " after ", t.keyframes.back().time);
       t.keyframes.push_back(f);
+    }
+  }
+  if (const auto g = n["gripper"]) {
+    const std::string gk = k("gripper");
+    p.check_map(g, gk, {"hinge", "jaws"}, "a gripper");
+    const YAML::Node hinge = p.required(g, gk, "hinge");
+    p.check_map(hinge, gk + ".hinge", {"origin", "axis"}, "a hinge");
+    if (const auto o = hinge["origin"]) t.hinge_origin = p.vec3(o, gk + ".hinge.origin");
+    const YAML::Node axis = p.required(hinge, gk + ".hinge", "axis");
+    t.hinge_axis = p.vec3(axis, gk + ".hinge.axis");
+    if (t.hinge_axis.norm() < 1e-9) p.error(axis, gk + ".hinge.axis", "must not be zero");
+    t.hinge_axis.normalize();
+    const YAML::Node jaws = p.required(g, gk, "jaws");
+    if (!jaws.IsSequence() || jaws.size() < 1 || jaws.size() > 2)
+      p.error(jaws, gk + ".jaws", "expected a list of one or two jaws");
+    for (std::size_t i = 0; i < jaws.size(); ++i) {
+      const std::string jk = SceneParser::item_key(gk + ".jaws", i);
+      p.check_map(jaws[i], jk, {"shape", "offset", "side"}, "a jaw");
+      ToolJawDescription jd;
+      jd.shape = parse_shape(p, p.required(jaws[i], jk, "shape"), jk + ".shape");
+      if (jd.shape.type == ShapeType::Plane) p.error(jaws[i]["shape"], jk + ".shape", "a jaw cannot be a plane");
+      if (const auto o = jaws[i]["offset"]) jd.offset = p.vec3(o, jk + ".offset");
+      if (const auto sd = jaws[i]["side"]) {
+        jd.side = p.number(sd, jk + ".side");
+        if (jd.side != 1 && jd.side != -1) p.error(sd, jk + ".side", "expected 1 or -1, got ", jd.side);
+      }
+      t.jaws.push_back(jd);
     }
   }
   if (const auto g = n["grasp"]) {
@@ -676,6 +704,22 @@ void emit_tool(YAML::Emitter& e, const ToolDescription& t) {
       << YAML::Value << damping(c.rotational_damping) << YAML::Key << "mass" << YAML::Value << num(c.mass)
       << YAML::Key << "max_force" << YAML::Value << num(c.max_force) << YAML::Key << "haptic_gain" << YAML::Value
       << num(c.haptic_gain) << YAML::EndMap;
+  }
+  if (!t.jaws.empty()) {
+    e << YAML::Key << "gripper" << YAML::Value << YAML::BeginMap << YAML::Key << "hinge" << YAML::Value << YAML::Flow
+      << YAML::BeginMap << YAML::Key << "origin" << YAML::Value;
+    emit(e, t.hinge_origin);
+    e << YAML::Key << "axis" << YAML::Value;
+    emit(e, t.hinge_axis);
+    e << YAML::EndMap << YAML::Key << "jaws" << YAML::Value << YAML::BeginSeq;
+    for (const ToolJawDescription& j : t.jaws) {
+      e << YAML::BeginMap << YAML::Key << "shape" << YAML::Value;
+      emit_shape(e, j.shape);
+      e << YAML::Key << "offset" << YAML::Value;
+      emit(e, j.offset);
+      e << YAML::Key << "side" << YAML::Value << num(j.side) << YAML::EndMap;
+    }
+    e << YAML::EndSeq << YAML::EndMap;
   }
   if (!t.sensors.empty()) {
     e << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;

@@ -131,6 +131,22 @@ struct SceneTool {
   std::uint64_t link_sequence = 0;               ///< the newest stream sample taken
   bool link_seen = false;
   int model_index = -1;  ///< coupled tools: their rigid body in the model
+  /// Gripper jaws: contact shapes turning about the hinge with the closure.
+  struct Jaw {
+    std::string name;  ///< "<tool>/jaw<i>": its contact terms' object and world frame
+    RigidObjectModel model;
+    Isometry offset = Isometry::Identity();
+    double side = 1;
+  };
+  std::vector<Jaw> jaws;
+  /// A jaw's pose in the tool frame at `closure` (rad): turned by side·closure/2 about the hinge.
+  Isometry jaw_in_tool(const Jaw& j, double closure) const {
+    Isometry H = Isometry::Identity();
+    H.translation() = desc->hinge_origin;
+    Isometry R = Isometry::Identity();
+    R.linear() = Eigen::AngleAxisd(j.side * 0.5 * closure, desc->hinge_axis).toRotationMatrix();
+    return H * R * H.inverse() * j.offset;
+  }
   VirtualCouplingOptions coupling;
   std::unique_ptr<teleop::PoseRecorder> recorder;  ///< --record: the device poses used
   PoseSample recorded;
@@ -313,6 +329,16 @@ void SceneSession::Impl::build() {
       mb.add_term(std::make_shared<const VirtualCouplingTerm>(t.desc->name, t.coupling), {t.model_index});
     }
     const bool coupled = t.model_index >= 0;
+    for (size_t j = 0; j < t.desc->jaws.size(); ++j) {
+      RigidObjectDescription as_object;
+      as_object.name = t.desc->name + "/jaw" + std::to_string(j);
+      as_object.shape = t.desc->jaws[j].shape;
+      as_object.kind = ObjectKind::Kinematic;
+      SceneTool::Jaw jaw{as_object.name, make_rigid_object(as_object, opt.cache_dir), Isometry::Identity(),
+                         t.desc->jaws[j].side};
+      jaw.offset.translation() = t.desc->jaws[j].offset;
+      t.jaws.push_back(std::move(jaw));
+    }
     if (t.desc->has_shape) {
       RigidObjectDescription as_object;
       as_object.name = t.desc->name;
@@ -328,6 +354,20 @@ void SceneSession::Impl::build() {
         co.stiffness = c.body_object_stiffness;
         co.friction = c.friction;
         auto term = std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
+                                                           coupled, co);
+        if (coupled) {
+          mb.add_term(term, {b.model_index, t.model_index});
+        } else {
+          mb.add_term(term, {b.model_index});
+        }
+      }
+      for (const SceneTool::Jaw& jaw : t.jaws) {
+        auto& pts = samples[b.avatar.get()];
+        if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
+        SdfContactOptions co;
+        co.stiffness = c.body_object_stiffness;
+        co.friction = c.friction;
+        auto term = std::make_shared<const SdfContactTerm>(jaw.name, *pts, jaw.model.field, Isometry::Identity(),
                                                            coupled, co);
         if (coupled) {
           mb.add_term(term, {b.model_index, t.model_index});
@@ -458,6 +498,14 @@ const StepReport& SceneSession::advance() {
     WorldFrame jaws = f;
     if (coupled) jaws = WorldFrame{sim.state(tl.model_index).bones[0]};
     const Isometry before = coupled ? jaws.pose : sample_pose(now);
+    for (const SceneTool::Jaw& jaw : tl.jaws) {
+      if (coupled) {
+        in.frames[moving_shape_frame_name(jaw.name)] = WorldFrame{before * tl.jaw_in_tool(jaw, next.closure)};
+      } else {
+        in.frames[jaw.name] = frame_between(before * tl.jaw_in_tool(jaw, now.closure),
+                                            sample_pose(next) * tl.jaw_in_tool(jaw, next.closure), h);
+      }
+    }
     for (size_t bi = 0; bi < tl.grasps.size(); ++bi) {
       GraspController& grasp = tl.grasps[bi];
       const SceneBody& b = m.bodies[bi];
@@ -489,7 +537,7 @@ const StepReport& SceneSession::advance() {
     ts.anchors = 0;
     ts.max_stretch = 0;
     for (const TermQuantityReport& q : rep.quantities) {
-      const bool contact = q.term == tl.contact_term;
+      const bool contact = q.term == tl.contact_term || q.term.rfind(tl.contact_term + "/jaw", 0) == 0;
       const bool anchor = q.term.rfind(tl.anchor_prefix, 0) == 0;
       if ((contact || anchor) && q.name == "force" && q.value.size() == 3)
         ts.force -= Vec3(q.value[0], q.value[1], q.value[2]);
@@ -619,6 +667,11 @@ SimulationResult SceneSession::result_header() const {
       r.objects.push_back({t.desc->name, shape_type_name(t.desc->shape.type),
                            t.model_index >= 0 ? "dynamic" : "kinematic", t.shape.surface.vertices,
                            t.shape.surface.faces, {}});
+  for (const SceneTool& t : m.tools)
+    for (size_t j = 0; j < t.jaws.size(); ++j)
+      r.objects.push_back({t.jaws[j].name, shape_type_name(t.desc->jaws[j].shape.type),
+                           t.model_index >= 0 ? "dynamic" : "kinematic", t.jaws[j].model.surface.vertices,
+                           t.jaws[j].model.surface.faces, {}});
   return r;
 }
 
@@ -629,6 +682,8 @@ std::vector<Isometry> SceneSession::object_poses() const {
   for (const SceneObject& o : m.objects) poses.push_back(m.object_pose(o, t));
   for (const SceneTool& tl : m.tools)
     if (tl.desc->has_shape) poses.push_back(tl.exact_pose() ? tl.state.pose : sample_pose(tl.track->at(t)));
+  for (const SceneTool& tl : m.tools)
+    for (const SceneTool::Jaw& j : tl.jaws) poses.push_back(tl.state.pose * tl.jaw_in_tool(j, tl.state.device.closure));
   return poses;
 }
 
@@ -661,6 +716,9 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
   size_t next = m.objects.size();
   for (const SceneTool& tl : m.tools)
     if (tl.desc->has_shape) r.objects[next++].poses.push_back(tl.exact_pose() ? tl.state.pose : sample_pose(tl.track->at(t)));
+  for (const SceneTool& tl : m.tools)
+    for (const SceneTool::Jaw& j : tl.jaws)
+      r.objects[next++].poses.push_back(tl.state.pose * tl.jaw_in_tool(j, tl.state.device.closure));
   ++r.num_frames;
 }
 

@@ -180,7 +180,11 @@ tools:
   ASSERT_TRUE(step_until_device_at(s, Vec3(0, 0.027, 0)));
   // A reply comes for every accepted pose, with the force of the latest step
   // (the one published before the link answered).
-  const auto fb = dev.feedback(1.0);
+  // (The link answers right after it stores the pose the session just took:
+  // read until the answer to the newest pose is in, within 1 s.)
+  std::optional<teleop::FeedbackMessage> fb;
+  for (int tries = 0; tries < 100 && !(fb && fb->sequence == seq - 1); ++tries)
+    if (auto got = dev.feedback(0.01)) fb = got;
   ASSERT_TRUE(fb.has_value());
   EXPECT_EQ(fb->sequence, seq - 1);
   EXPECT_GT(fb->force.y(), 0.1);
@@ -241,4 +245,51 @@ tools:
   EXPECT_EQ(replay.tool_state(0).feedback_force, live.tool_state(0).feedback_force);
   ASSERT_EQ(replay.tool_events().size(), live.tool_events().size());
   EXPECT_EQ(replay.tool_events()[1].time, live.tool_events()[1].time);
+}
+
+TEST_F(ToolSession, GripperJawsTurnAboutTheHingeWithTheClosureAndTouchTheFlesh) {
+  // Two capsule jaws hanging 1 cm below a hinge 2 mm above the top, 4 mm
+  // either side of it; the device closes them from 1 rad to 0 over 0.2 s.
+  SceneDescription sc = read_scene_description(write_scene(R"(
+solver: {dt: 1/250, seconds: 0.3, gravity: [0, 0, 0]}
+output: {fps: 50}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.038, 0.0], closure: 1.0}
+      - {time: 0.2, position: [0.0, 0.038, 0.0], closure: 0.0}
+    gripper:
+      hinge: {origin: [0, 0, 0], axis: [1, 0, 0]}
+      jaws:
+        - {shape: {type: capsule, radius: 0.002, length: 0.01}, offset: [0, -0.01, 0.004], side: 1}
+        - {shape: {type: capsule, radius: 0.002, length: 0.01}, offset: [0, -0.01, -0.004], side: -1}
+)"));
+  SceneSession s(sc, quiet());
+  SimulationResult r = s.result_header();
+  ASSERT_EQ(r.objects.size(), 2u);
+  EXPECT_EQ(r.objects[0].name, "gripper/jaw0");
+  double peak = 0;
+  while (s.steps_done() < s.total_steps()) {
+    s.advance();
+    peak = std::max(peak, s.tool_state(0).force.y());
+    if (s.steps_done() == 25) s.record_frame(r, 0.0);  // t = 0.1 s: closure 0.5 rad
+  }
+  s.record_frame(r, 0.0);
+  // At t = 0.1 s jaw 0 is turned by +0.25 rad about x through the hinge (the
+  // tool origin), jaw 1 by −0.25 rad: by hand, R_x(±0.25) · offset + tool.
+  const Vec3 tool(0.0, 0.038, 0.0);
+  for (int j = 0; j < 2; ++j) {
+    const double a = (j == 0 ? 1 : -1) * 0.25;
+    const Mat3 R = Eigen::AngleAxisd(a, Vec3::UnitX()).toRotationMatrix();
+    const Vec3 offset(0, -0.01, j == 0 ? 0.004 : -0.004);
+    const Isometry& P = r.objects[j].poses.at(0);
+    EXPECT_LT((P.linear() - R).norm(), 1e-12) << "jaw " << j;
+    EXPECT_LT((P.translation() - (tool + R * offset)).norm(), 1e-12) << "jaw " << j;
+  }
+  // Shut (closure 0): the jaws hang straight, their tips 2 mm + radius into
+  // the top; the flesh pushes the tool up through them.
+  EXPECT_LT((r.objects[0].poses.back().translation() - (tool + Vec3(0, -0.01, 0.004))).norm(), 1e-12);
+  EXPECT_GT(peak, 0.05);
 }

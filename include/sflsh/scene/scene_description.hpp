@@ -82,6 +82,11 @@
 //       coupling: {stiffness: 2.0e4, damping: auto, rotational_stiffness: 20,
 //                  rotational_damping: auto, mass: 0.1, max_force: 20, haptic_gain: 1}
 //                               # optional: a dynamic tool pulled by its device (virtual coupling)
+//       gripper:                # optional: jaws that turn about a hinge by ±closure/2 (tool frame)
+//         hinge: {origin: [0, 0.03, 0], axis: [1, 0, 0]}
+//         jaws:
+//           - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, 0.004], side: 1}
+//           - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, -0.004], side: -1}
 //       grasp:                  # optional: proximity sensors and anchors (AMBF Alg. 3)
 //         sensors: [{origin: [0, 0, 0], direction: [0, 0, -1], range: 0.01}]  # tool frame, m
 //         closure_threshold: 0.2   # rad: anchors while the closure is below it; default 0.2
@@ -188,6 +193,15 @@ struct ToolSensorDescription {
   double range = 0.01;            ///< m
 };
 
+/// One jaw of a tool's gripper: a contact shape in its own frame, placed in
+/// the tool frame at `offset` and turned about the gripper's hinge by
+/// side · closure / 2 (side +1 or −1: the two jaws open in opposite senses).
+struct ToolJawDescription {
+  ShapeDescription shape;
+  Vec3 offset = Vec3::Zero();  ///< m, the jaw frame's origin in the tool frame at closure 0
+  double side = 1;             ///< +1 or −1
+};
+
 /// Virtual coupling of a tool to its device (sim/energies/virtual_coupling.hpp).
 struct ToolCouplingDescription {
   double stiffness = 2.0e4;             ///< N/m
@@ -215,6 +229,11 @@ struct ToolDescription {
   double stream_max_speed = 20.0;          ///< m/s: samples implying a faster jump are rejected
   bool coupled = false;                    ///< virtual coupling (else kinematic)
   ToolCouplingDescription coupling;
+  /// Two-jaw gripper (optional): the hinge (a point and an axis in the tool
+  /// frame) and the jaws, which turn about it with the device's closure.
+  Vec3 hinge_origin = Vec3::Zero();
+  Vec3 hinge_axis = Vec3::UnitX();
+  std::vector<ToolJawDescription> jaws;
   std::vector<ToolSensorDescription> sensors;  ///< grasp sensors; none: the tool cannot grasp
   double closure_threshold = 0.2;          ///< rad: grasp while the closure is below it
   double hardness = 2.0e4;                 ///< N/m per anchor
