@@ -4,7 +4,17 @@
 
 namespace sflsh::teleop {
 
-PoseStreamLink::PoseStreamLink(PoseStreamServerOptions options) : server_(std::move(options)) {
+namespace {
+
+/// One datagram per poll, so every accepted pose gets its own answer.
+PoseStreamServerOptions one_per_poll(PoseStreamServerOptions o) {
+  o.max_datagrams_per_poll = 1;
+  return o;
+}
+
+}  // namespace
+
+PoseStreamLink::PoseStreamLink(PoseStreamServerOptions options) : server_(one_per_poll(std::move(options))) {
   port_ = server_.port();
   thread_ = std::thread([this] { run(); });
 }
@@ -18,6 +28,7 @@ void PoseStreamLink::run() {
   const auto start = std::chrono::steady_clock::now();
   while (!stop_) {
     if (!server_.wait_readable(0.005)) continue;  // wakes at least every 5 ms to see stop_
+    // One datagram at a time: each accepted pose is answered at once.
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::optional<StreamSample> got = server_.poll(now);
     FeedbackMessage f;
