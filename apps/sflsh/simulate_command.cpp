@@ -1,6 +1,7 @@
 // `sflsh simulate`: drive an avatar with a motion, write the result cache,
 // optional exports and a picture.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -32,7 +33,25 @@ struct SimulateArgs {
   int newton_iters = 1, render_frames = 6;
   bool line_search = false, use_file_betas = false, start_at_rest = false;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
+  double tracking_tolerance_mm = 20;
+  bool strict = false;
 };
+
+/// Dynamic bones can lag behind their motion (damped steps, strong contact):
+/// a warning when the pelvis strays more than the tolerance from the
+/// motion's root; with --strict, an error (the result file is still written).
+void check_tracking(const SimulationResult& r, const SimulateArgs& a) {
+  if (!r.bones_dynamic || r.pelvis_error_max * 1e3 <= a.tracking_tolerance_mm) return;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "the pelvis strayed up to %.1f mm from the motion's root (mean %.1f mm; tolerance %.1f mm, "
+                "--tracking-tolerance); %d of %d steps were damped. Try --newton-iters 3, --max-rotation-step 0 or a "
+                "smaller --dt",
+                r.pelvis_error_max * 1e3, r.pelvis_error_mean * 1e3, a.tracking_tolerance_mm, r.damped,
+                r.accepted + r.damped + r.rejected);
+  if (a.strict) fail("simulate --strict: ", buf);
+  std::cerr << "warning: " << buf << "\n";
+}
 
 
 /// `sflsh simulate scene.yaml`: the scene's outputs, overridden by --out/--export/--render when given.
@@ -146,6 +165,7 @@ void run_simulate(const SimulateArgs& a) {
       throw_if_interrupted("after the last step");
       writer.finish(r);
       std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
+      check_tracking(r, a);
     } catch (const Interrupted& e) {
       const std::string partial = a.out + ".partial";
       throw Interrupted(std::string(e.what()) + "; " +
@@ -202,6 +222,11 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--cache-dir", a->cache_dir,
                   "Cache of template stages and --use-file-betas avatars (default: $SFLSH_CACHE_DIR or ~/.cache/sflsh)");
   cmd->add_option("--out", a->out, "Result file (HDF5)")->capture_default_str();
+  cmd->add_option("--tracking-tolerance", a->tracking_tolerance_mm,
+                  "Dynamic bones: warn when the pelvis strays farther than this from the motion's root (mm)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--strict", a->strict, "Exit non-zero (after writing the result) when the tracking tolerance is exceeded");
   cmd->add_option("--checkpoint", a->checkpoint, "Also save the final state (HDF5) to continue from with --resume");
   cmd->add_option("--resume", a->resume,
                   "Continue from a --checkpoint file: same avatar, motion and options; --seconds is the end time");
