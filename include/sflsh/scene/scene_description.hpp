@@ -5,8 +5,8 @@
 // model and state.
 //
 // Top-level keys follow DESIGN.md §5b (bodies, objects, tools, contact,
-// solver, output; a tool's pose comes from keyframes or a pose file, live
-// streams are not read yet; tools touch every body, whatever `pairs` says).
+// solver, output; a tool's pose comes from keyframes, a pose file or a live
+// UDP stream; tools touch every body, whatever `pairs` says).
 // Coordinates are the avatar's frame, Y up, facing +Z: the built-in avatar stands on y = 0 (soles at y = -0.01 m, pelvis
 // at 0.94 m, belly front near z = 0.11 m at y = 1.05 m).
 //
@@ -69,7 +69,7 @@
 //       keyframes:              # required, times >= 0 strictly increasing
 //         - {time: 0, position: [0, 1.3, 0.3], orientation: [1, 0, 0, 0]}
 //         - {time: 2, position: [0, 1.1, 0.3]}   # orientation defaults to identity
-//   tools:                      # optional: teleoperated tools (issue 11), kinematic frames
+//   tools:                      # optional: teleoperated tools (issue 11; scene_session.hpp)
 //     - name: pincher           # required; unique across bodies, objects and tools
 //       shape: {type: capsule, radius: 0.005, length: 0.03}  # optional contact shape (as objects')
 //       keyframes:              # the pose source: keyframes, or `pose_file` (exactly one)

@@ -1,29 +1,10 @@
 #pragma once
-// Running a scene file (`sflsh simulate scene.yaml`, issue 10): the
-// SceneDescription (scene_description.hpp) becomes a Model — bodies with
-// their soft-tissue and skeleton terms, dynamic rigid objects as 6-DoF bodies,
-// and only the contact terms the scene's pairs need — and is stepped with
-// StepInputs carrying each body's motion targets and the static and kinematic
-// objects as named world frames. The result holds every body's skin
-// (concatenated, SimulationResult::body_vertex_offsets) and the objects' poses.
-//
-// Scene conventions (documented for users in scene_description.hpp):
-//   * placement P (offset, heading about +Y) is applied to the motion: the
-//     body's targets are P·G(t); with a non-zero `velocity` the placement
-//     travels, P(t) = T(velocity·t)·P, and the body starts with that velocity;
-//   * a body without a motion holds its rest pose with its joint springs but
-//     its root is free (it falls, rolls and comes to rest under contact);
-//   * bodies that collide with another body track their motion's root with a
-//     force limit (body_push_limit × body weight) so that contact, not the
-//     motion, decides where they meet;
-//   * tools (issue 11) are kinematic frames following keyframes or a pose
-//     file: with a shape they touch every body (SdfContactTerm), with sensors
-//     they grasp (GraspController, AMBF Alg. 3) through one AnchorTerm per
-//     body; the force on the tool is minus what those terms exert;
-//   * contact: one SdfContactTerm per colliding body–object pair (skin samples
-//     every `sample_spacing`), one CapsuleContactTerm per colliding pair of
-//     bodies (skipped when both are kinematic), and one per body with
-//     self_contact; object–object contact is not modelled.
+// Running a scene file as fast as possible (`sflsh simulate scene.yaml`,
+// issue 10): a SceneSession (scene_session.hpp: how the scene becomes a model
+// and what its bodies, objects and tools do) stepped to its end, every
+// output frame recorded, and the contact and tool figures gathered. The
+// result holds every body's skin (concatenated,
+// SimulationResult::body_vertex_offsets) and the objects' and tools' poses.
 #include <functional>
 #include <string>
 #include <vector>
