@@ -12,6 +12,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/line_plot_svg.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
@@ -28,13 +29,14 @@ struct Site {
   Vec3 outward = Vec3::UnitZ();       ///< the body faces +z
 };
 
-/// A kinematic sphere moving along the belly normal: gap(t) is the signed
-/// distance (m) of its surface from the belly point along the outward normal.
+/// A kinematic sphere moving along the site's normal: gap(t) is the signed
+/// distance (m) of its surface from the site's point along the outward normal.
 struct Scene {
   std::string name;
   double radius = 0, dt = 0;
   int steps = 0;
   std::function<double(double)> gap;
+  bool thigh = false;  ///< the site: the left thigh (else the belly)
   Vec3 centre(const Site& s, double t) const { return s.point + s.outward * (radius + gap(t)); }
 };
 
@@ -47,6 +49,7 @@ struct Trace {
   double sample_iterations = 0;     // Σ active samples × Newton iterations over contact steps
   int max_active = 0;
   double peak_force = 0;            // N
+  std::vector<double> force;        // |contact force| per step (N)
   int unconverged = 0;              // full FEM: steps that stopped before the gradient tolerance
 };
 
@@ -81,6 +84,24 @@ Site belly_site(const Avatar& a) {
   return s;
 }
 
+Site thigh_site(const Avatar& a) {
+  require(a.joints_rest.rows() == 24, "bench-contact: the avatar has ", a.joints_rest.rows(), " joints, expected 24");
+  const Vec3 hip = a.joints_rest.row(1).transpose(), knee = a.joints_rest.row(4).transpose();  // left hip, knee
+  int best = -1;
+  double best_z = 0;
+  for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
+    const Vec3 x = a.surface_rest.row(v).transpose();
+    const double s = (x.y() - knee.y()) / (hip.y() - knee.y());
+    if (s < 0.4 || s > 0.6 || std::abs(x.x() - (knee.x() + s * (hip.x() - knee.x()))) > 0.04 || !simulated_vertex(a, v))
+      continue;
+    if (best < 0 || x.z() > best_z) best = v, best_z = x.z();
+  }
+  require(best >= 0, "bench-contact: no simulated skin vertex on the front of the left thigh");
+  Site s;
+  s.point = a.surface_rest.row(best).transpose();
+  return s;
+}
+
 std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
   require(o.pressed_radius > 0 && o.impact_radius > 0 && o.impact_speed > 0 && o.pressed_depth > 0 &&
               o.impact_depth > 0 && o.pressed_dt > 0 && o.impact_dt > 0 && o.stiffness > 0 && o.newton_iters >= 1,
@@ -97,6 +118,13 @@ std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
     const double total = o.quick ? 0.1 : 0.3;
     Scene s{"impact", o.impact_radius, o.impact_dt, int(std::lround(total / o.impact_dt)), nullptr};
     s.gap = [=](double t) { return t < turn ? start - v * t : -depth + v * (t - turn); };
+    scenes.push_back(s);
+  }
+  {
+    require(o.probe_radius > 0 && o.probe_depth > 0 && o.probe_dt > 0, "bench-contact: probe radius, depth and dt must be positive");
+    const double start = 0.002, depth = o.probe_depth, ramp = o.quick ? 0.5 : 1.5, total = ramp + (o.quick ? 0.1 : 0.25);
+    Scene s{"probe", o.probe_radius, o.probe_dt, int(std::lround(total / o.probe_dt)), nullptr, true};
+    s.gap = [=](double t) { return start - (start + depth) * std::min(std::max(t, 0.0) / ramp, 1.0); };
     scenes.push_back(s);
   }
   return scenes;
@@ -128,6 +156,7 @@ Trace run_full(std::shared_ptr<const Avatar> avatar, const Scene& sc, const Site
     if (!rep.converged) ++tr.unconverged;
     tr.max_active = std::max(tr.max_active, c.active_samples);
     tr.peak_force = std::max(tr.peak_force, c.force.norm());
+    tr.force.push_back(c.force.norm());
     p.update(i);
   }
   p.finish();
@@ -174,10 +203,12 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
     tr.u.push_back(sim.soft_displacement());
     tr.ms.push_back(rep.ms_total);
     int active = 0;
+    double force = 0;
     for (const TermQuantityReport& q : rep.quantities)
       if (q.term == term && q.name == "active_samples") active = int(q.value.at(0));
-      else if (q.term == term && q.name == "force")
-        tr.peak_force = std::max(tr.peak_force, Vec3(q.value.at(0), q.value.at(1), q.value.at(2)).norm());
+      else if (q.term == term && q.name == "force") force = Vec3(q.value.at(0), q.value.at(1), q.value.at(2)).norm();
+    tr.peak_force = std::max(tr.peak_force, force);
+    tr.force.push_back(force);
     tr.contact.push_back(active > 0);
     tr.max_active = std::max(tr.max_active, active);
     if (active > 0) {
@@ -209,6 +240,17 @@ double peak_dent(const Trace& tr, const Avatar& a, const Site& site, double reac
   return dent;
 }
 
+/// The force (N) where the depth curve first reaches `depth` (m), linearly
+/// interpolated between steps; NaN when it never does.
+double force_at_depth(const std::vector<double>& depth_mm, const std::vector<double>& force, double depth) {
+  for (size_t i = 1; i < depth_mm.size() && i < force.size(); ++i)
+    if (depth_mm[i] >= 1e3 * depth && depth_mm[i - 1] < 1e3 * depth) {
+      const double w = (1e3 * depth - depth_mm[i - 1]) / (depth_mm[i] - depth_mm[i - 1]);
+      return force[i - 1] + w * (force[i] - force[i - 1]);
+    }
+  return std::nan("");
+}
+
 double relative_error(const Trace& tr, const Trace& ref) {
   double diff2 = 0, ref2 = 0;
   for (size_t f = 0; f < std::min(tr.u.size(), ref.u.size()); ++f) {
@@ -229,11 +271,21 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
                 a->surface_rest.rows() == base.surface_rest.rows(),
             "bench-contact: the avatars do not share the tet mesh and skin (", a->tet.num_nodes(), " vs ",
             base.tet.num_nodes(), " nodes)");
-  const Site site = belly_site(base);
-  log_info("bench-contact: belly point (" + std::to_string(site.point.x()) + ", " + std::to_string(site.point.y()) +
-           ", " + std::to_string(site.point.z()) + ") m");
+  const Site belly = belly_site(base), thigh = thigh_site(base);
+  log_info("bench-contact: belly point (" + std::to_string(belly.point.x()) + ", " + std::to_string(belly.point.y()) +
+           ", " + std::to_string(belly.point.z()) + ") m, thigh point (" + std::to_string(thigh.point.x()) + ", " +
+           std::to_string(thigh.point.y()) + ", " + std::to_string(thigh.point.z()) + ") m");
   std::vector<ContactBenchRow> rows;
+  for (const std::string& name : settings.scenes) {
+    bool known = false;
+    for (const Scene& sc : make_scenes(settings)) known = known || sc.name == name;
+    require(known, "bench-contact: unknown scene '", name, "' (scenes: pressed, impact, probe)");
+  }
   for (const Scene& sc : make_scenes(settings)) {
+    if (!settings.scenes.empty() &&
+        std::find(settings.scenes.begin(), settings.scenes.end(), sc.name) == settings.scenes.end())
+      continue;
+    const Site& site = sc.thigh ? thigh : belly;
     const Trace ref = run_full(avatars[0], sc, site, settings);
     const double reach = 1.5 * sc.radius;
     const double dent_ref = peak_dent(ref, base, site, reach);
@@ -258,6 +310,12 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
       r.ms_no_contact = median_when(without.ms, with.contact);
       r.step_ratio = r.ms_no_contact > 0 ? r.ms_contact / r.ms_no_contact : 0;
       r.ms_full = median_when(ref.ms, ref.contact);
+      for (int i = 1; i <= sc.steps; ++i) r.curve_depth_mm.push_back(-1e3 * sc.gap(i * sc.dt));
+      r.curve_force_full_n = ref.force;
+      r.curve_force_reduced_n = with.force;
+      r.force_at_depth_full_n = force_at_depth(r.curve_depth_mm, ref.force, settings.probe_report_depth);
+      r.force_at_depth_reduced_n = force_at_depth(r.curve_depth_mm, with.force, settings.probe_report_depth);
+      r.force_err = std::abs(r.force_at_depth_reduced_n - r.force_at_depth_full_n) / r.force_at_depth_full_n;
       rows.push_back(r);
     }
   }
@@ -300,6 +358,44 @@ void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std
   out.commit();
 }
 
+void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::string& csv_path,
+                        const std::string& svg_path, double report_depth) {
+  std::vector<const ContactBenchRow*> probe;
+  for (const auto& r : rows)
+    if (r.scene == "probe") probe.push_back(&r);
+  require(!probe.empty(), "bench-contact: no probe rows to plot");
+  const ContactBenchRow& first = *probe[0];
+  io::AtomicOutput out(csv_path);
+  {
+    std::ofstream f(out.temp_path());
+    if (!f) fail(csv_path, ": cannot write");
+    f << "depth_mm,full_n";
+    for (const auto* r : probe) f << ",K" << r->handles << "_n";
+    f << "\n";
+    for (size_t i = 0; i < first.curve_depth_mm.size(); ++i) {
+      f << first.curve_depth_mm[i] << "," << first.curve_force_full_n.at(i);
+      for (const auto* r : probe) f << "," << r->curve_force_reduced_n.at(i);
+      f << "\n";
+    }
+    if (!f) fail(csv_path, ": write failed");
+  }
+  out.commit();
+  // The loading ramp only (up to the deepest point), where depth increases.
+  size_t n = 0;
+  while (n + 1 < first.curve_depth_mm.size() && first.curve_depth_mm[n + 1] > first.curve_depth_mm[n]) ++n;
+  auto head = [&](const std::vector<double>& v) { return std::vector<double>(v.begin(), v.begin() + long(n + 1)); };
+  std::vector<io::PlotSeries> series;
+  series.push_back({"full FEM", head(first.curve_depth_mm), head(first.curve_force_full_n), "#444444", true});
+  int c = 0;
+  for (const auto* r : probe) {
+    char label[96];
+    std::snprintf(label, sizeof label, "K = %d (%+.0f%% at %.0f mm)", r->handles, 100.0 * (r->force_at_depth_reduced_n / r->force_at_depth_full_n - 1.0), 1e3 * report_depth);
+    series.push_back({label, head(first.curve_depth_mm), head(r->curve_force_reduced_n), io::plot_color(c++), false});
+  }
+  io::write_line_plot_svg(svg_path, "Probe (2 cm sphere) pressed into the thigh: force against depth",
+                          "kinematic depth below the undeformed skin (mm)", "contact force (N)", series);
+}
+
 void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
                                   const std::string& heading) {
   io::AtomicOutput out(path);
@@ -317,6 +413,17 @@ void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, cons
                     r.scene.c_str(), r.handles, 1.0 / r.dt, r.rel_err, r.dent_full_mm, r.dent_reduced_mm, r.dent_ratio,
                     r.force_full_n, r.force_reduced_n, r.active_samples_full, r.active_samples, r.us_per_sample_iter,
                     r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
+      f << buf;
+    }
+    bool header = false;
+    for (const auto& r : rows) {
+      if (r.scene != "probe") continue;
+      if (!header)
+        f << "\nProbe force at 10 mm depth (first crossing on the loading ramp):\n\n| K | full FEM (N) | reduced (N) | "
+             "error |\n|---|---|---|---|\n";
+      header = true;
+      std::snprintf(buf, sizeof buf, "| %d | %.2f | %.2f | %.0f %% |\n", r.handles, r.force_at_depth_full_n,
+                    r.force_at_depth_reduced_n, 100.0 * r.force_err);
       f << buf;
     }
     if (!f) fail(path, ": write failed");

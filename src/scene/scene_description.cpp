@@ -300,7 +300,9 @@ RigidObjectDescription parse_object(const SceneParser& p, const YAML::Node& n, c
 }
 
 ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std::string& key) {
-  p.check_map(n, key, {"name", "shape", "keyframes", "pose_file", "grasp"}, "a tool");
+  p.check_map(n, key, {"name", "shape", "keyframes", "pose_file", "pose_interpolation", "pose_stream", "coupling", "gripper",
+               "grasp"},
+              "a tool");
   auto k = [&](const std::string& c) { return SceneParser::child_key(key, c); };
   ToolDescription t;
   t.name = p.text(p.required(n, key, "name"), k("name"));
@@ -308,9 +310,51 @@ ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std:
     t.shape = parse_shape(p, s, k("shape"));
     t.has_shape = true;
   }
-  const YAML::Node kf = n["keyframes"], file = n["pose_file"];
-  if (bool(kf) == bool(file)) p.error(n, key, "give exactly one pose source: 'keyframes' or 'pose_file'");
+  const YAML::Node kf = n["keyframes"], file = n["pose_file"], stream = n["pose_stream"];
+  if (stream) {
+    if (file) p.error(file, k("pose_file"), "give one pose source: 'pose_stream' or 'pose_file', not both");
+    const std::string sk = k("pose_stream");
+    p.check_map(stream, sk, {"port", "max_speed"}, "a pose stream");
+    const double port = p.non_negative(p.required(stream, sk, "port"), sk + ".port");
+    if (port != std::floor(port) || port > 65535)
+      p.error(stream["port"], sk + ".port", "expected a UDP port number 0..65535 (0: any free port), got ", port);
+    t.stream_port = int(port);
+    if (const auto v = stream["max_speed"]) t.stream_max_speed = p.positive(v, sk + ".max_speed");
+  } else if (bool(kf) == bool(file)) {
+    p.error(n, key, "give exactly one pose source: 'keyframes', 'pose_file' or 'pose_stream'");
+  }
   if (file) t.pose_file = p.existing_file(file, k("pose_file"), "pose file");
+  if (const auto v = n["pose_interpolation"]) {
+    const std::string mode = p.text(v, k("pose_interpolation"));
+    if (!file) p.error(v, k("pose_interpolation"), "applies to a pose_file only");
+    if (mode != "linear" && mode != "hold")
+      p.error(v, k("pose_interpolation"), "expected 'linear' or 'hold', got '", mode, "'");
+    t.pose_file_hold = mode == "hold";
+  }
+  if (const auto cn = n["coupling"]) {
+    const std::string ck = k("coupling");
+    p.check_map(cn, ck,
+                {"stiffness", "damping", "rotational_stiffness", "rotational_damping", "mass", "max_force",
+                 "haptic_gain"},
+                "a virtual coupling");
+    ToolCouplingDescription& c = t.coupling;
+    auto damping = [&](const char* name, double& out) {
+      if (const auto v = cn[name]) {
+        if (v.IsScalar() && v.Scalar() == "auto")
+          out = -1;
+        else
+          out = p.non_negative(v, ck + "." + name);
+      }
+    };
+    if (const auto v = cn["stiffness"]) c.stiffness = p.positive(v, ck + ".stiffness");
+    if (const auto v = cn["rotational_stiffness"]) c.rotational_stiffness = p.positive(v, ck + ".rotational_stiffness");
+    damping("damping", c.damping);
+    damping("rotational_damping", c.rotational_damping);
+    if (const auto v = cn["mass"]) c.mass = p.positive(v, ck + ".mass");
+    if (const auto v = cn["max_force"]) c.max_force = p.positive(v, ck + ".max_force");
+    if (const auto v = cn["haptic_gain"]) c.haptic_gain = p.non_negative(v, ck + ".haptic_gain");
+    t.coupled = true;
+  }
   if (kf) {
     if (!kf.IsSequence() || kf.size() == 0) p.error(kf, k("keyframes"), "expected a list of at least one keyframe");
     for (std::size_t i = 0; i < kf.size(); ++i) {
@@ -324,6 +368,33 @@ ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std:
       if (i > 0 && f.time <= t.keyframes.back().time)
         p.error(kf[i], ik + ".time", "keyframe times must increase, got ", f.time, " after ", t.keyframes.back().time);
       t.keyframes.push_back(f);
+    }
+  }
+  if (const auto g = n["gripper"]) {
+    const std::string gk = k("gripper");
+    p.check_map(g, gk, {"hinge", "jaws"}, "a gripper");
+    const YAML::Node hinge = p.required(g, gk, "hinge");
+    p.check_map(hinge, gk + ".hinge", {"origin", "axis"}, "a hinge");
+    if (const auto o = hinge["origin"]) t.hinge_origin = p.vec3(o, gk + ".hinge.origin");
+    const YAML::Node axis = p.required(hinge, gk + ".hinge", "axis");
+    t.hinge_axis = p.vec3(axis, gk + ".hinge.axis");
+    if (t.hinge_axis.norm() < 1e-9) p.error(axis, gk + ".hinge.axis", "must not be zero");
+    t.hinge_axis.normalize();
+    const YAML::Node jaws = p.required(g, gk, "jaws");
+    if (!jaws.IsSequence() || jaws.size() < 1 || jaws.size() > 2)
+      p.error(jaws, gk + ".jaws", "expected a list of one or two jaws");
+    for (std::size_t i = 0; i < jaws.size(); ++i) {
+      const std::string jk = SceneParser::item_key(gk + ".jaws", i);
+      p.check_map(jaws[i], jk, {"shape", "offset", "side"}, "a jaw");
+      ToolJawDescription jd;
+      jd.shape = parse_shape(p, p.required(jaws[i], jk, "shape"), jk + ".shape");
+      if (jd.shape.type == ShapeType::Plane) p.error(jaws[i]["shape"], jk + ".shape", "a jaw cannot be a plane");
+      if (const auto o = jaws[i]["offset"]) jd.offset = p.vec3(o, jk + ".offset");
+      if (const auto sd = jaws[i]["side"]) {
+        jd.side = p.number(sd, jk + ".side");
+        if (jd.side != 1 && jd.side != -1) p.error(sd, jk + ".side", "expected 1 or -1, got ", jd.side);
+      }
+      t.jaws.push_back(jd);
     }
   }
   if (const auto g = n["grasp"]) {
@@ -607,9 +678,15 @@ void emit_tool(YAML::Emitter& e, const ToolDescription& t) {
     e << YAML::Key << "shape" << YAML::Value;
     emit_shape(e, t.shape);
   }
+  if (t.stream_port >= 0) {
+    e << YAML::Key << "pose_stream" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "port"
+      << YAML::Value << t.stream_port << YAML::Key << "max_speed" << YAML::Value << num(t.stream_max_speed)
+      << YAML::EndMap;
+  }
   if (!t.pose_file.empty()) {
     e << YAML::Key << "pose_file" << YAML::Value << t.pose_file;
-  } else {
+    e << YAML::Key << "pose_interpolation" << YAML::Value << (t.pose_file_hold ? "hold" : "linear");
+  } else if (!t.keyframes.empty()) {
     e << YAML::Key << "keyframes" << YAML::Value << YAML::BeginSeq;
     for (const auto& f : t.keyframes) {
       e << YAML::Flow << YAML::BeginMap << YAML::Key << "time" << YAML::Value << num(f.time);
@@ -617,6 +694,32 @@ void emit_tool(YAML::Emitter& e, const ToolDescription& t) {
       e << YAML::Key << "closure" << YAML::Value << num(f.closure) << YAML::EndMap;
     }
     e << YAML::EndSeq;
+  }
+  if (t.coupled) {
+    const ToolCouplingDescription& c = t.coupling;
+    auto damping = [&](double v) { return v < 0 ? std::string("auto") : num(v); };
+    e << YAML::Key << "coupling" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "stiffness"
+      << YAML::Value << num(c.stiffness) << YAML::Key << "damping" << YAML::Value << damping(c.damping) << YAML::Key
+      << "rotational_stiffness" << YAML::Value << num(c.rotational_stiffness) << YAML::Key << "rotational_damping"
+      << YAML::Value << damping(c.rotational_damping) << YAML::Key << "mass" << YAML::Value << num(c.mass)
+      << YAML::Key << "max_force" << YAML::Value << num(c.max_force) << YAML::Key << "haptic_gain" << YAML::Value
+      << num(c.haptic_gain) << YAML::EndMap;
+  }
+  if (!t.jaws.empty()) {
+    e << YAML::Key << "gripper" << YAML::Value << YAML::BeginMap << YAML::Key << "hinge" << YAML::Value << YAML::Flow
+      << YAML::BeginMap << YAML::Key << "origin" << YAML::Value;
+    emit(e, t.hinge_origin);
+    e << YAML::Key << "axis" << YAML::Value;
+    emit(e, t.hinge_axis);
+    e << YAML::EndMap << YAML::Key << "jaws" << YAML::Value << YAML::BeginSeq;
+    for (const ToolJawDescription& j : t.jaws) {
+      e << YAML::BeginMap << YAML::Key << "shape" << YAML::Value;
+      emit_shape(e, j.shape);
+      e << YAML::Key << "offset" << YAML::Value;
+      emit(e, j.offset);
+      e << YAML::Key << "side" << YAML::Value << num(j.side) << YAML::EndMap;
+    }
+    e << YAML::EndSeq << YAML::EndMap;
   }
   if (!t.sensors.empty()) {
     e << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;

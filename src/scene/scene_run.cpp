@@ -1,131 +1,18 @@
 #include "sflsh/scene/scene_run.hpp"
 
-#include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
 #include <map>
 #include <sstream>
 
-#include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/progress.hpp"
-#include "sflsh/core/rotation.hpp"
-#include "sflsh/motion/load_motion.hpp"
-#include "sflsh/scene/material_file.hpp"
-#include "sflsh/scene/result_file.hpp"
-#include "sflsh/scene/rigid_object.hpp"
-#include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/io/atomic_output.hpp"
-#include "sflsh/sim/energies/anchor.hpp"
-#include "sflsh/sim/energies/capsule_contact.hpp"
-#include "sflsh/sim/grasp_controller.hpp"
-#include "sflsh/teleop/pose_file.hpp"
-#include "sflsh/teleop/pose_track.hpp"
-#include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/scene/scene_session.hpp"
 #include "sflsh/sim/momentum.hpp"
-#include "sflsh/sim/rigid_body_terms.hpp"
-#include "sflsh/sim/simulator.hpp"
-#include "sflsh/sim/skeleton_terms.hpp"
-#include "sflsh/sim/soft_tissue_terms.hpp"
 
 namespace sflsh {
-namespace {
-
-using teleop::PoseSample;
-using teleop::PoseTrack;
-
-/// A body of the scene as the run drives it.
-struct SceneBody {
-  const BodyDescription* desc = nullptr;
-  std::shared_ptr<const Avatar> avatar;
-  bool has_motion = false;
-  MotionClip motion;
-  int model_index = 0;
-  Isometry placement = Isometry::Identity();  ///< at t = 0
-};
-
-struct SceneObject {
-  const RigidObjectDescription* desc = nullptr;
-  RigidObjectModel model;
-  int model_index = -1;  ///< dynamic objects: their body in the model
-};
-
-/// The placement at time t: heading about +Y, offset, travelling at the body's velocity.
-Isometry placement_at(const SceneBody& b, double t) {
-  Isometry P = b.placement;
-  if (b.has_motion) P.translation() += b.desc->velocity * t;
-  return P;
-}
-
-/// The motion's pose at t (the rest pose without a motion), placed by P.
-BodyPose placed_pose(const SceneBody& b, double t) {
-  BodyPose pose = b.has_motion ? b.motion.sample(t) : BodyPose{};
-  const Isometry P = placement_at(b, t);
-  const Vec3 root = b.avatar->joints_rest.row(0).transpose();
-  pose.axis_angle.row(0) = rotation_log(P.linear() * rodrigues(pose.axis_angle.row(0).transpose())).transpose();
-  pose.translation = P * (root + pose.translation) - root;
-  return pose;
-}
-
-std::string motion_spec_name(const std::string& spec) {
-  const size_t slash = spec.find_last_of('/');
-  return slash == std::string::npos ? spec : spec.substr(slash + 1);
-}
-
-/// A tool as the run drives it: its pose track, contact field, and per body
-/// a grasp controller with its anchor term's key.
-struct SceneTool {
-  const ToolDescription* desc = nullptr;
-  std::unique_ptr<PoseTrack> track;
-  RigidObjectModel shape;  ///< when desc->has_shape
-  std::vector<GraspController> grasps;  ///< per body (when the tool has sensors)
-  std::vector<std::string> anchor_keys;  ///< per body: the anchor term's tool name
-  std::string contact_term;              ///< "contact:<tool>": its contact terms' name
-  std::string anchor_prefix;             ///< "anchor:<tool>@": its anchor terms' names start so
-};
-
-/// The world frame at t + h from the poses at t and t + h (twist by finite difference).
-WorldFrame frame_between(const Isometry& before, const Isometry& after, double h) {
-  WorldFrame f;
-  f.pose = after;
-  f.linear_velocity = (after.translation() - before.translation()) / h;
-  f.angular_velocity = rotation_log(after.linear() * before.linear().transpose()) / h;
-  return f;
-}
-
-PoseTrack tool_track(const ToolDescription& t) {
-  if (!t.pose_file.empty()) return PoseTrack(teleop::read_pose_file(t.pose_file), t.pose_file);
-  std::vector<PoseSample> samples;
-  for (const ToolKeyframe& k : t.keyframes) samples.push_back({k.time, k.position, k.orientation, k.closure});
-  return PoseTrack(std::move(samples), "tool '" + t.name + "' keyframes");
-}
-
-Isometry sample_pose(const PoseSample& s) {
-  Isometry T = Isometry::Identity();
-  T.linear() = s.orientation.normalized().toRotationMatrix();
-  T.translation() = s.position;
-  return T;
-}
-
-/// Where body `b` starts: the placed motion at t = 0, moving with the motion
-/// (and the body's velocity) over the first step.
-BodyState initial_state(const SceneBody& b, double h) {
-  BodyState s;
-  s.q.bones = target_bones(*b.avatar, placed_pose(b, 0.0));
-  s.q.z = VecX::Zero(b.avatar->num_reduced());
-  s.q_prev.z = s.q.z;
-  const std::vector<Isometry> next = target_bones(*b.avatar, placed_pose(b, h));
-  for (size_t j = 0; j < s.q.bones.size(); ++j) {
-    Isometry prev = b.has_motion ? Isometry(s.q.bones[j] * next[j].inverse() * s.q.bones[j]) : s.q.bones[j];
-    if (!b.has_motion) prev.translation() -= b.desc->velocity * h;
-    s.q_prev.bones.push_back(prev);
-  }
-  return s;
-}
-
-}  // namespace
 
 void SceneContactStats::write_tool_log(const std::string& path) const {
   io::AtomicOutput out(path);
@@ -168,245 +55,15 @@ std::string SceneContactStats::describe() const {
 }
 
 SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& opt, SceneContactStats* stats) {
-  require(!sc.bodies.empty(), sc.path, ": the scene has no bodies");
-  const double h = sc.solver.dt;
-
-  // Bodies: avatars (read once per file and material), motions, placement.
-  std::map<std::string, std::shared_ptr<const Avatar>> avatars;
-  std::vector<SceneBody> bodies(sc.bodies.size());
-  double seconds = sc.solver.seconds;
-  for (size_t i = 0; i < sc.bodies.size(); ++i) {
-    const BodyDescription& d = sc.bodies[i];
-    SceneBody& b = bodies[i];
-    b.desc = &d;
-    const std::string key = d.avatar + "\n" + d.material;
-    auto it = avatars.find(key);
-    if (it == avatars.end()) {
-      auto a = std::make_shared<Avatar>(read_avatar(d.avatar));
-      if (!d.material.empty()) apply_material_file(d.material, a->materials);
-      it = avatars.emplace(key, std::move(a)).first;
-    }
-    b.avatar = it->second;
-    b.placement.linear() = Eigen::AngleAxisd(d.heading_deg * M_PI / 180.0, Vec3::UnitY()).toRotationMatrix();
-    b.placement.translation() = d.offset;
-    if (d.motion != "none") {
-      MotionOptions mo;
-      mo.rest_joints = b.avatar->joints_rest;
-      mo.builtin_seconds = seconds > 0 ? seconds : 5.0;
-      try {
-        b.motion = load_motion(d.motion, mo);
-      } catch (const Error& e) {
-        fail(sc.path, ": bodies '", d.name, "': motion ", d.motion, ": ", e.what());
-      }
-      b.has_motion = true;
-      if (sc.solver.seconds == 0) seconds = std::max(seconds, b.motion.duration());
-    }
-  }
-  require(seconds > 0, sc.path, ": solver.seconds is 0 and no body has a motion; give solver.seconds");
-  const long steps = std::max(1L, long(std::llround(seconds / h)));
-
-  // The model.
-  ModelOptions mo;
-  mo.h = h;
-  mo.gravity = sc.solver.gravity;
-  mo.newton.iterations = sc.solver.newton_iterations;
-  mo.newton.line_search = sc.solver.line_search;
-  ModelBuilder mb(mo);
-  auto in_body_contact = [&](const BodyDescription& d) {
-    for (const BodyDescription& other : sc.bodies)
-      if (&other != &d && sc.collides(d.name, other.name)) return true;
-    return false;
-  };
-  for (SceneBody& b : bodies) {
-    b.model_index = mb.add_body({b.desc->name, b.avatar, b.desc->bones_dynamic});
-    add_soft_tissue_terms(mb, b.model_index, {true, sc.solver.damping});
-    if (b.desc->bones_dynamic) {
-      SkeletonTermsOptions sk;
-      sk.track_root = b.has_motion;
-      if (in_body_contact(*b.desc))
-        sk.root_force_limit = opt.body_push_limit * estimate_body_mass(*b.avatar) * mo.gravity.norm();
-      add_skeleton_terms(mb, b.model_index, sk);
-    }
-  }
-  std::vector<SceneObject> objects(sc.objects.size());
-  for (size_t i = 0; i < sc.objects.size(); ++i) {
-    SceneObject& o = objects[i];
-    o.desc = &sc.objects[i];
-    o.model = make_rigid_object(*o.desc, opt.cache_dir);
-    if (!o.model.bake_report.empty() && opt.progress) std::cerr << o.desc->name << ": " << o.model.bake_report << "\n";
-    if (o.desc->kind == ObjectKind::Dynamic) {
-      o.model_index = mb.add_body({o.desc->name, nullptr, true});
-      add_rigid_body_terms(mb, o.model_index, o.model.mass.mass, o.model.mass.inertia);
-    }
-  }
-  // Contact terms: only the pairs the scene asks for.
-  const ContactDescription& c = sc.contact;
-  std::map<const Avatar*, std::shared_ptr<const PosedPoints>> samples;
-  for (const SceneBody& b : bodies) {
-    for (const SceneObject& o : objects) {
-      if (!sc.collides(b.desc->name, o.desc->name)) continue;
-      auto& pts = samples[b.avatar.get()];
-      if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
-      SdfContactOptions co;
-      co.stiffness = c.body_object_stiffness;
-      co.friction = c.friction;
-      const bool dynamic = o.model_index >= 0;
-      auto term = std::make_shared<const SdfContactTerm>(o.desc->name, *pts, o.model.field,
-                                                         dynamic ? o.model.shape_in_body : Isometry::Identity(),
-                                                         dynamic, co);
-      if (dynamic) {
-        mb.add_term(term, {b.model_index, o.model_index});
-      } else {
-        mb.add_term(term, {b.model_index});
-      }
-    }
-  }
-  // Tools: kinematic frames; contact with every body through their shape,
-  // grasping through anchors (one anchor term per tool and body).
-  std::vector<SceneTool> tools(sc.tools.size());
-  for (size_t i = 0; i < sc.tools.size(); ++i) {
-    SceneTool& t = tools[i];
-    t.desc = &sc.tools[i];
-    t.contact_term = "contact:" + t.desc->name;
-    t.anchor_prefix = "anchor:" + t.desc->name + "@";
-    try {
-      t.track = std::make_unique<PoseTrack>(tool_track(*t.desc));
-    } catch (const Error& e) {
-      fail(sc.path, ": tools '", t.desc->name, "': ", e.what());
-    }
-    if (t.desc->has_shape) {
-      RigidObjectDescription as_object;
-      as_object.name = t.desc->name;
-      as_object.shape = t.desc->shape;
-      as_object.kind = ObjectKind::Kinematic;
-      t.shape = make_rigid_object(as_object, opt.cache_dir);
-    }
-    for (const SceneBody& b : bodies) {
-      if (t.desc->has_shape) {
-        auto& pts = samples[b.avatar.get()];
-        if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
-        SdfContactOptions co;
-        co.stiffness = c.body_object_stiffness;
-        co.friction = c.friction;
-        mb.add_term(std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
-                                                           false, co),
-                    {b.model_index});
-      }
-      if (!t.desc->sensors.empty()) {
-        GraspOptions go;
-        for (const ToolSensorDescription& sd : t.desc->sensors) go.sensors.push_back({sd.origin, sd.direction, sd.range});
-        go.closure_threshold = t.desc->closure_threshold;
-        t.grasps.emplace_back(go);
-        t.anchor_keys.push_back(t.desc->name + "@" + b.desc->name);
-        mb.add_term(std::make_shared<const AnchorTerm>(t.anchor_keys.back(), PosedPoints::at_surface(*b.avatar), false,
-                                                       AnchorOptions{t.desc->hardness, t.desc->damping}),
-                    {b.model_index});
-      }
-    }
-  }
-  for (size_t i = 0; i < bodies.size(); ++i) {
-    const SceneBody& a = bodies[i];
-    for (size_t j = i + 1; j < bodies.size(); ++j) {
-      const SceneBody& b = bodies[j];
-      if (!sc.collides(a.desc->name, b.desc->name)) continue;
-      if (!a.desc->bones_dynamic && !b.desc->bones_dynamic) continue;  // nothing can move
-      require(!a.avatar->capsules.empty() && !b.avatar->capsules.empty(), sc.path, ": bodies '", a.desc->name,
-              "' and '", b.desc->name, "' collide, but an avatar has no bone capsules (/skeleton/capsules)");
-      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, b.avatar.get(),
-                                                             CapsuleContactOptions{c.body_body_stiffness, 2}),
-                  {a.model_index, b.model_index});
-    }
-    if (c.self_contact && a.desc->bones_dynamic && !a.avatar->capsules.empty())
-      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, nullptr,
-                                                             CapsuleContactOptions{c.self_stiffness, 2}),
-                  {a.model_index});
-  }
-  Simulator sim(mb.build());
-
-  // Initial state.
-  State s = sim.scene_state();
-  for (const SceneBody& b : bodies) s.bodies[b.model_index] = initial_state(b, h);
-  for (const SceneObject& o : objects) {
-    if (o.model_index < 0) continue;
-    const Isometry G = object_pose_at(*o.desc, 0.0) * o.model.shape_in_body.inverse();
-    Isometry G_prev = G;
-    G_prev.translation() -= o.desc->velocity * h;
-    const double w = o.desc->angular_velocity.norm();
-    if (w > 0)
-      G_prev.linear() = Eigen::AngleAxisd(-w * h, o.desc->angular_velocity / w).toRotationMatrix() * G.linear();
-    s.bodies[o.model_index] = {Configuration{{G}, VecX(0)}, Configuration{{G_prev}, VecX(0)}};
-  }
-  sim.set_state(s);
-
-  // Result skeleton: every body's skin concatenated, the objects' surfaces.
-  SimulationResult r;
-  r.motion = sc.path.empty() ? std::string("scene") : motion_spec_name(sc.path);
-  r.dt = h;
-  r.bones_dynamic = bodies[0].desc->bones_dynamic;
-  r.newton_iters = sc.solver.newton_iterations;
-  r.body_vertex_offsets.push_back(0);
-  {
-    std::string names;
-    int V = 0, F = 0;
-    for (const SceneBody& b : bodies) {
-      V += int(b.avatar->surface_rest.rows());
-      F += int(b.avatar->surface_faces.rows());
-    }
-    r.surface_rest.resize(V, 3);
-    r.faces.resize(F, 3);
-    V = F = 0;
-    for (const SceneBody& b : bodies) {
-      r.surface_rest.middleRows(V, b.avatar->surface_rest.rows()) = b.avatar->surface_rest;
-      r.faces.middleRows(F, b.avatar->surface_faces.rows()) = b.avatar->surface_faces.array() + V;
-      V += int(b.avatar->surface_rest.rows());
-      F += int(b.avatar->surface_faces.rows());
-      r.body_names.push_back(b.desc->name);
-      r.body_vertex_offsets.push_back(V);
-      names += (names.empty() ? "" : ", ") + b.desc->name + " (" + motion_spec_name(b.desc->avatar) + ")";
-    }
-    r.avatar = names;
-  }
-  for (const SceneObject& o : objects)
-    r.objects.push_back({o.desc->name, shape_type_name(o.desc->shape.type), object_kind_name(o.desc->kind),
-                         o.model.surface.vertices, o.model.surface.faces, {}});
-
-  for (const SceneTool& t : tools)
-    if (t.desc->has_shape)
-      r.objects.push_back({t.desc->name, shape_type_name(t.desc->shape.type), "kinematic", t.shape.surface.vertices,
-                           t.shape.surface.faces, {}});
-  auto object_pose = [&](const SceneObject& o, double t) {
-    if (o.model_index < 0) return object_pose_at(*o.desc, t);
-    return Isometry(sim.state(o.model_index).bones[0] * o.model.shape_in_body);
-  };
-  auto record_frame = [&](double t, double ms) {
-    const int V = r.body_vertex_offsets.back();
-    Points positions(V, 3), displacement(V, 3), joints(24 * int(bodies.size()), 3);
-    VecX reduced(0);
-    for (size_t i = 0; i < bodies.size(); ++i) {
-      const int v0 = r.body_vertex_offsets[i], n = r.body_vertex_offsets[i + 1] - v0, k = bodies[i].model_index;
-      positions.middleRows(v0, n) = sim.posed_surface(k);
-      displacement.middleRows(v0, n) = sim.soft_displacement(k);
-      joints.middleRows(24 * int(i), 24) = sim.joints(k);
-      const VecX& z = sim.state(k).z;
-      VecX grown(reduced.size() + z.size());
-      grown << reduced, z;
-      reduced = std::move(grown);
-    }
-    const SceneBody& b0 = bodies[0];
-    r.frame_time.push_back(t);
-    r.frame_step_ms.push_back(ms);
-    r.frame_positions.push_back(std::move(positions));
-    r.frame_displacement.push_back(std::move(displacement));
-    r.frame_joints.push_back(std::move(joints));
-    r.frame_reduced.push_back(std::move(reduced));
-    r.frame_target_pelvis.push_back(placed_pose(b0, t).translation + b0.avatar->joints_rest.row(0).transpose());
-    for (size_t i = 0; i < objects.size(); ++i) r.objects[i].poses.push_back(object_pose(objects[i], t));
-    size_t next = objects.size();
-    for (const SceneTool& tl : tools)
-      if (tl.desc->has_shape) r.objects[next++].poses.push_back(sample_pose(tl.track->at(t)));
-    ++r.num_frames;
-  };
-  record_frame(0.0, 0.0);
+  SceneSessionOptions so;
+  so.progress = opt.progress;
+  so.cache_dir = opt.cache_dir;
+  so.body_push_limit = opt.body_push_limit;
+  SceneSession session(sc, so);
+  const Simulator& sim = session.simulator();
+  const long steps = session.total_steps();
+  SimulationResult r = session.result_header();
+  session.record_frame(r, 0.0);
 
   SceneContactStats st;
   st.momentum_start = linear_momentum(sim.model(), sim.scene_state());
@@ -414,65 +71,20 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
   const double frame_dt = 1.0 / sc.output.fps;
   double next_frame = frame_dt, ms_since_frame = 0;
   int steps_since_frame = 0;
-  StepInputs in;
-  in.bodies.resize(sim.model().bodies().size());
   Progress progress("simulating " + r.motion, steps);
   for (long k = 0; k < steps; ++k) {
     if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
-    const double t = (k + 1) * h;
-    for (const SceneBody& b : bodies) {
-      BodyTargets& bt = in.bodies[b.model_index];
-      bt.pose = placed_pose(b, t);
-      bt.bones = target_bones(*b.avatar, bt.pose);
+    const StepReport& rep = session.advance();
+    const double t = (k + 1) * session.dt();
+    for (int i = 0; i < session.num_tools(); ++i) {
+      const SceneToolState& ts = session.tool_state(i);
+      st.tool_steps.push_back({t, session.tool_name(i), ts.force, ts.anchors, ts.max_stretch});
     }
-    for (const SceneObject& o : objects) {
-      if (o.model_index >= 0) continue;
-      in.frames[o.desc->name] = frame_between(object_pose_at(*o.desc, t - h), object_pose_at(*o.desc, t), h);
-    }
-    for (SceneTool& tl : tools) {
-      const PoseSample now = tl.track->at(t - h);
-      const Isometry before = sample_pose(now);
-      const WorldFrame f = frame_between(before, sample_pose(tl.track->at(t)), h);
-      in.frames[tl.desc->name] = f;
-      for (size_t bi = 0; bi < tl.grasps.size(); ++bi) {
-        GraspController& grasp = tl.grasps[bi];
-        const SceneBody& b = bodies[bi];
-        // The posed skin only while the jaws look for something to grasp.
-        const Points skin = grasp.seeking(now.closure) ? sim.posed_surface(b.model_index) : Points();
-        if (grasp.update(t - h, before, now.closure, skin, b.avatar->surface_faces)) {
-          const GraspEvent& ev = grasp.log().back();
-          st.tool_events.push_back({ev.time, tl.desc->name, b.desc->name,
-                                    ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
-        }
-        add_anchor_frames(tl.anchor_keys[bi], f, grasp.anchors(), false, in.frames);
-      }
-    }
-    const StepReport rep = sim.step(in);
-    // Tool feedback: the force on each tool is minus what its contact and
-    // anchor terms exert on the bodies.
-    for (const SceneTool& tl : tools) {
-      SceneContactStats::ToolStep ts{t, tl.desc->name};
-      for (const TermQuantityReport& q : rep.quantities) {
-        const bool contact = q.term == tl.contact_term;
-        const bool anchor = q.term.rfind(tl.anchor_prefix, 0) == 0;
-        if ((contact || anchor) && q.name == "force" && q.value.size() == 3)
-          ts.force -= Vec3(q.value[0], q.value[1], q.value[2]);
-        if (anchor && q.name == "anchor_points") ts.anchors += int(q.value.size());
-        if (anchor && q.name == "max_stretch") ts.max_stretch = std::max(ts.max_stretch, q.value[0]);
-      }
-      st.tool_steps.push_back(ts);
-    }
-    for (const SceneBody& b : bodies)
-      if (!sim.state(b.model_index).z.allFinite() || !sim.state(b.model_index).bones[0].matrix().allFinite())
-        fail(sc.path, ": body '", b.desc->name, "' became non-finite at step ", k + 1, " (t = ", t,
-             " s); try a smaller solver.dt or lower contact stiffness");
-    for (const SceneObject& o : objects)
-      if (o.model_index >= 0 && !sim.state(o.model_index).bones[0].matrix().allFinite())
-        fail(sc.path, ": object '", o.desc->name, "' became non-finite at step ", k + 1, " (t = ", t, " s)");
     // Contact figures from the terms' reports.
     for (SceneContactStats::Pair& p : st.pairs) p.last_force.setZero();  // inactive terms report nothing
     for (const TermQuantityReport& q : rep.quantities) {
-      if (q.term.rfind("anchor:", 0) == 0) continue;  // tools' anchors: in tool_steps
+      // Tools' anchors and couplings: in tool_steps.
+      if (q.term.rfind("anchor:", 0) == 0 || q.term.rfind("coupling:", 0) == 0) continue;
       const auto key = std::make_pair(q.term, q.body);
       auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
       if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});
@@ -489,7 +101,7 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     ms_since_frame += rep.ms_total;
     ++steps_since_frame;
     if (t + 1e-9 >= next_frame) {
-      record_frame(t, ms_since_frame / steps_since_frame);
+      session.record_frame(r, ms_since_frame / steps_since_frame);
       next_frame += frame_dt;
       ms_since_frame = 0;
       steps_since_frame = 0;
@@ -497,6 +109,8 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();
+  for (const SceneToolEvent& e : session.tool_events())
+    st.tool_events.push_back({e.time, e.tool, e.body, e.kind, e.points});
   st.momentum_end = linear_momentum(sim.model(), sim.scene_state());
   if (stats) *stats = std::move(st);
   return r;

@@ -10,7 +10,7 @@
 
 namespace sflsh {
 
-void add_rigid_body_terms(ModelBuilder& builder, int body, double mass, const Mat3& inertia) {
+void add_rigid_body_terms(ModelBuilder& builder, int body, double mass, const Mat3& inertia, bool gravity) {
   require(mass > 0 && std::isfinite(mass), "rigid object: mass ", mass, " kg, expected > 0");
   require(inertia.allFinite() && (inertia - inertia.transpose()).norm() <= 1e-9 * inertia.norm(),
           "rigid object: the inertia tensor is not finite and symmetric");
@@ -19,7 +19,7 @@ void add_rigid_body_terms(ModelBuilder& builder, int body, double mass, const Ma
           eig.eigenvalues().minCoeff(), " kg m^2)");
   const std::vector<BoneBody> bodies{{mass, Vec3::Zero(), inertia}};
   builder.add_term(std::make_unique<BoneInertia>(bodies), body);
-  if (builder.options().gravity.squaredNorm() > 0) builder.add_term(std::make_unique<BoneGravity>(bodies), body);
+  if (gravity && builder.options().gravity.squaredNorm() > 0) builder.add_term(std::make_unique<BoneGravity>(bodies), body);
 }
 
 }  // namespace sflsh

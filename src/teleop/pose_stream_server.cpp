@@ -3,9 +3,11 @@
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <iostream>
@@ -125,6 +127,12 @@ bool PoseStreamServer::send_feedback(const Vec3& force, const Vec3& torque, doub
   if (n != static_cast<ssize_t>(bytes.size())) return false;
   ++feedback_sent_;
   return true;
+}
+
+bool PoseStreamServer::wait_readable(double timeout) const {
+  pollfd p{fd_, POLLIN, 0};
+  const int ms = int(std::max(0.0, timeout) * 1000.0 + 0.5);
+  return ::poll(&p, 1, ms) > 0 && (p.revents & POLLIN);
 }
 
 }  // namespace sflsh::teleop

@@ -13,8 +13,7 @@
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_run.hpp"
-#include "sim/skeleton_fixture.hpp"
-#include "sim/synthetic_avatar.hpp"
+#include "scene/box_avatar_fixture.hpp"
 #include "test_support.hpp"
 
 using namespace sflsh;
@@ -22,33 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A folder with a small avatar file (6 cm box of 1 cm cells, top at y = 0.03 m).
-class SceneRun : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sflsh_scene_run_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-    test::SyntheticAvatarOptions o;
-    o.nx = o.nz = 6;
-    o.cell = 0.01;
-    o.handles = 6;
-    o.handle_radius = 0.1;
-    o.all_tets = false;
-    o.samples = 10;
-    Avatar a = test::make_synthetic_avatar(o);
-    a.joints_rest = test::make_tpose_skeleton().joints_rest;
-    a.capsules = {{3, Vec3(0, 0.005, 0), Vec3(0, 0.025, 0), 0.025}};
-    write_avatar(a, (dir_ / "box.h5").string());
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string write_scene(const std::string& text) {
-    const std::string p = (dir_ / "scene.yaml").string();
-    std::ofstream(p) << text;
-    return p;
-  }
-  fs::path dir_;
-};
+using SceneRun = test::BoxAvatarScene;
 
 TEST_F(SceneRun, ABallFallsFreelyAnotherRestsOnTheBody) {
   // "drop", far from the body, falls freely: backward Euler from rest gives

@@ -10,10 +10,19 @@
 //   impact:  a kinematic ball (radius 11 cm) starts 2 cm in front, moves in at
 //            3 m/s until 3 cm deep, then leaves at 3 m/s; 0.3 s in all, time
 //            step 1/240 s (the contact lasts ~30 ms: 7 steps).
+//   probe:   a kinematic sphere probe (radius 2 cm) starts 2 mm in front of the
+//            left thigh, presses 15 mm deep along the inward normal over 1.5 s
+//            (quasi-static: 1 cm/s) and is held 0.25 s; time step 1/60 s. The
+//            force–depth curve is compared (issue 11): |force| of the contact
+//            per step against the probe's kinematic depth below the
+//            undeformed skin; force_err = |F_red − F_full| / F_full at 10 mm.
 //
 // The belly point p is the front-most skin vertex (largest z; the body faces
 // +z) with |x| < 5 cm between the pelvis and spine2 joint heights whose tet
-// has a Simulated node; the inward normal is −z. Every skin vertex is a
+// has a Simulated node; the inward normal is −z. The thigh point is the
+// front-most skin vertex of the left thigh between 40 % and 60 % of the way
+// from knee to hip, within 4 cm (in x) of the thigh's axis, whose tet has a
+// Simulated node; its inward normal is −z as well. Every skin vertex is a
 // contact sample (reduced: skin_contact_samples; full FEM: FullFem obstacles),
 // with the same stiffness.
 //
@@ -47,6 +56,11 @@ struct ContactBenchSettings {
   double impact_speed = 3.0;     ///< m/s
   double impact_depth = 0.03;    ///< m, deepest kinematic penetration of the ball
   double pressed_dt = 1.0 / 60.0, impact_dt = 1.0 / 240.0;  ///< s
+  double probe_radius = 0.02;     ///< m
+  double probe_depth = 0.015;     ///< m, deepest kinematic depth of the probe
+  double probe_dt = 1.0 / 60.0;   ///< s
+  double probe_report_depth = 0.01;  ///< m: force_err is taken there
+  std::vector<std::string> scenes;   ///< which scenes to run (empty: pressed, impact, probe)
 };
 
 struct ContactBenchOptions {
@@ -70,6 +84,12 @@ struct ContactBenchRow {
   double us_per_sample_iter = 0; ///< µs in the reduced contact term per active sample per Newton iteration
   double ms_contact = 0, ms_no_contact = 0, step_ratio = 0;  ///< reduced step medians (steps with contact)
   double ms_full = 0;            ///< full-FEM median step time (steps with contact)
+  /// Per step: the object's kinematic depth below the undeformed skin point
+  /// (mm; negative = not touching yet) and |contact force| (N) of both solvers.
+  std::vector<double> curve_depth_mm, curve_force_full_n, curve_force_reduced_n;
+  /// The forces at settings.probe_report_depth (first crossing, interpolated)
+  /// and their relative difference |F_red − F_full| / F_full (probe scene).
+  double force_at_depth_full_n = 0, force_at_depth_reduced_n = 0, force_err = 0;
 };
 
 /// Runs both scenes on `avatars` (one per handle count; they must share the
@@ -85,6 +105,10 @@ std::vector<ContactBenchRow> run_contact_benchmark(const ContactBenchOptions& op
 /// dent_ratio,force_full_n,force_reduced_n,active_samples,active_samples_full,us_per_sample_iter,
 /// ms_contact,ms_no_contact,step_ratio,ms_full (written as PATH.partial, then renamed).
 void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std::string& path);
+/// The probe's force–depth curves (rows of scene "probe"): CSV
+/// depth_mm,full_n,K<k>_n... (one row per step) and an SVG plot.
+void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::string& csv_path,
+                        const std::string& svg_path, double report_depth);
 /// The rows as a Markdown table, `heading` (Markdown) above it.
 void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
                                   const std::string& heading);

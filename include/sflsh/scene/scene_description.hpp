@@ -76,6 +76,17 @@
 //         - {time: 0, position: [0, 1.1, 0.12], orientation: [1, 0, 0, 0], closure: 1.0}
 //         - {time: 0.2, position: [0, 1.1, 0.12], closure: 0}   # closure: jaw opening, rad
 //       pose_file: pinch.csv    # CSV (time,x,y,z,qw,qx,qy,qz,closure) or JSON lines (README)
+//       pose_interpolation: linear   # or hold: a recorded live session (sflsh run --record)
+//       pose_stream: {port: 7001, max_speed: 20}  # or a live device (UDP, README); keyframes
+//                               # then give the pose until the first sample
+//       coupling: {stiffness: 2.0e4, damping: auto, rotational_stiffness: 20,
+//                  rotational_damping: auto, mass: 0.1, max_force: 20, haptic_gain: 1}
+//                               # optional: a dynamic tool pulled by its device (virtual coupling)
+//       gripper:                # optional: jaws that turn about a hinge by ±closure/2 (tool frame)
+//         hinge: {origin: [0, 0.03, 0], axis: [1, 0, 0]}
+//         jaws:
+//           - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, 0.004], side: 1}
+//           - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, -0.004], side: -1}
 //       grasp:                  # optional: proximity sensors and anchors (AMBF Alg. 3)
 //         sensors: [{origin: [0, 0, 0], direction: [0, 0, -1], range: 0.01}]  # tool frame, m
 //         closure_threshold: 0.2   # rad: anchors while the closure is below it; default 0.2
@@ -182,14 +193,47 @@ struct ToolSensorDescription {
   double range = 0.01;            ///< m
 };
 
-/// A teleoperated tool (issue 11): a kinematic frame driven by its pose
-/// source, optionally with a contact shape and a grasp (sensors + anchors).
+/// One jaw of a tool's gripper: a contact shape in its own frame, placed in
+/// the tool frame at `offset` and turned about the gripper's hinge by
+/// side · closure / 2 (side +1 or −1: the two jaws open in opposite senses).
+struct ToolJawDescription {
+  ShapeDescription shape;
+  Vec3 offset = Vec3::Zero();  ///< m, the jaw frame's origin in the tool frame at closure 0
+  double side = 1;             ///< +1 or −1
+};
+
+/// Virtual coupling of a tool to its device (sim/energies/virtual_coupling.hpp).
+struct ToolCouplingDescription {
+  double stiffness = 2.0e4;             ///< N/m
+  double damping = -1;                  ///< N·s/m; < 0: critical, 2√(k m)
+  double rotational_stiffness = 20.0;   ///< N·m/rad
+  double rotational_damping = -1;       ///< N·m·s/rad; < 0: critical, 2√(k_r I)
+  double mass = 0.1;                    ///< kg, the tool body (gravity-compensated by the device)
+  double max_force = 20.0;              ///< N: the force sent to the device is clamped to it
+  double haptic_gain = 1.0;             ///< the force and torque sent to the device are scaled by it
+};
+
+/// A teleoperated tool (issue 11): a frame driven by its pose source —
+/// kinematic, or with `coupling` a dynamic body pulled by its device —,
+/// optionally with a contact shape and a grasp (sensors + anchors).
 struct ToolDescription {
   std::string name;
   bool has_shape = false;
   ShapeDescription shape;                  ///< contact shape (when has_shape)
   std::vector<ToolKeyframe> keyframes;     ///< pose source: keyframes ...
   std::string pose_file;                   ///< ... or a pose file (CSV / JSON lines), absolute
+  bool pose_file_hold = false;             ///< pose file read with zero-order hold (a recording), not linearly
+  /// ... or a live UDP stream on 127.0.0.1:stream_port (0: any free port;
+  /// −1: none); keyframes, if given, hold the tool until the first sample.
+  int stream_port = -1;
+  double stream_max_speed = 20.0;          ///< m/s: samples implying a faster jump are rejected
+  bool coupled = false;                    ///< virtual coupling (else kinematic)
+  ToolCouplingDescription coupling;
+  /// Two-jaw gripper (optional): the hinge (a point and an axis in the tool
+  /// frame) and the jaws, which turn about it with the device's closure.
+  Vec3 hinge_origin = Vec3::Zero();
+  Vec3 hinge_axis = Vec3::UnitX();
+  std::vector<ToolJawDescription> jaws;
   std::vector<ToolSensorDescription> sensors;  ///< grasp sensors; none: the tool cannot grasp
   double closure_threshold = 0.2;          ///< rad: grasp while the closure is below it
   double hardness = 2.0e4;                 ///< N/m per anchor

@@ -12,7 +12,8 @@ namespace sflsh {
 
 /// Adds inertia (mass `mass` kg > 0, inertia tensor `inertia` kg·m² about the
 /// centre of mass in the object's axes, symmetric positive definite) and, when
-/// the model's gravity is non-zero, gravity for the rigid object `body`.
-void add_rigid_body_terms(ModelBuilder& builder, int body, double mass, const Mat3& inertia);
+/// the model's gravity is non-zero and `gravity` is true, gravity for the
+/// rigid object `body` (false: a tool whose device carries its weight).
+void add_rigid_body_terms(ModelBuilder& builder, int body, double mass, const Mat3& inertia, bool gravity = true);
 
 }  // namespace sflsh

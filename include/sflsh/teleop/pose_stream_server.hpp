@@ -61,6 +61,10 @@ class PoseStreamServer {
   /// the first accepted sample or when the socket buffer is full.
   bool send_feedback(const Vec3& force, const Vec3& torque, double sim_time);
 
+  /// Blocks until a datagram is waiting or `timeout` seconds pass (≥ 0);
+  /// returns whether one is waiting. Lets a thread answer at the device rate.
+  bool wait_readable(double timeout) const;
+
   const PoseStreamCounters& counters() const { return counters_; }
   long feedback_sent() const { return feedback_sent_; }
 

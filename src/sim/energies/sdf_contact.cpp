@@ -20,6 +20,7 @@ struct ContactCache : TermCache {
   std::vector<double> lambda;
   std::vector<Vec3> normal, x_t, carried;
   Isometry object_t = Isometry::Identity();    // dynamic: the object's body pose at t
+  Isometry shape_in_frame = Isometry::Identity();  // dynamic: this step's shape-in-body transform
 };
 
 /// IPC's friction mollifier: f1 = f0′ and f1′ at slip z ≥ 0 (ε > 0).
@@ -87,8 +88,10 @@ const std::vector<int>& SdfContactTerm::candidates(const StepContext& ctx) const
 Isometry SdfContactTerm::field_pose(const StepContext& ctx) const {
   if (!dynamic_) return contact_cache(ctx, name()).frame_pose;
   require(ctx.bound.size() == 2 && ctx.bound[1].q != nullptr, name(), ": the object's body is not bound");
-  return ctx.bound[1].q->bones[0] * shape_in_frame_;
+  return ctx.bound[1].q->bones[0] * contact_cache(ctx, name()).shape_in_frame;
 }
+
+std::string moving_shape_frame_name(const std::string& object) { return object + "/shape"; }
 
 void SdfContactTerm::begin_step(const StepContext& ctx) const {
   ContactCache& c = contact_cache(ctx, name());
@@ -102,7 +105,17 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
   if (dynamic_) {
     require(ctx.bound.size() == 2, name(), ": a dynamic object's contact is bound to the body and the object");
     const Isometry& G = ctx.bound[1].q_prev->bones[0];
-    T = G * shape_in_frame_;
+    c.shape_in_frame = shape_in_frame_;
+    if (ctx.frames) {
+      // A shape that moves on its body (a gripper's jaw): its pose for this
+      // step, given in the world relative to the body's pose at t.
+      const auto it = ctx.frames->find(moving_shape_frame_name(object_));
+      if (it != ctx.frames->end()) {
+        require(it->second.pose.matrix().allFinite(), name(), ": world frame '", it->first, "' is not finite");
+        c.shape_in_frame = G.inverse() * it->second.pose;
+      }
+    }
+    T = G * c.shape_in_frame;
     if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
       const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];
       object_motion = 2 * ((G.translation() - Gp.translation()).norm() +

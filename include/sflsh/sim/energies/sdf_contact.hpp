@@ -14,7 +14,11 @@
 //     (StepInputs::frames[object]) gives T at t + h; the term is bound to the
 //     body alone;
 //   * dynamic: a rigid-object body of the model (model.hpp), bound second;
-//     T = G_object · shape_in_frame at the current iterate, and the term also
+//     T = G_object · shape_in_frame at the current iterate (a shape that
+//     moves on its body, like a gripper's jaw, gives its pose for the step as
+//     the world frame moving_shape_frame_name(object) = "<object>/shape":
+//     G_t · S with G_t the body's pose at t and S the shape's pose in the
+//     body at t + h; the term then uses S for the step), and the term also
 //     fills the object's 6 DoFs: ∂φ/∂ω = −x × ∇φ, ∂φ/∂v = −∇φ (the tangent
 //     of configuration.hpp: a point of the object moves by ω × x + v at first
 //     order, whatever the pivot), so the forces on body and object are equal
@@ -61,6 +65,9 @@ struct SdfContactOptions {
   /// Slip speed (m/s) below which friction acts as a spring (ε = this·h).
   double static_slip_speed = 1e-3;
 };
+
+/// "<object>/shape": the world frame giving a dynamic object's moving shape for a step (header).
+std::string moving_shape_frame_name(const std::string& object);
 
 class SdfContactTerm : public EnergyTerm {
  public:

@@ -1,0 +1,168 @@
+#pragma once
+// A scene advanced one step at a time (issue 11): the SceneDescription
+// (scene_description.hpp) becomes a Model — bodies with their soft-tissue and
+// skeleton terms, dynamic rigid objects as 6-DoF bodies, tools, and only the
+// contact terms the scene's pairs need — and a State, stepped with StepInputs
+// that carry each body's motion targets and the static and kinematic objects
+// and tools as named world frames.
+//
+// `sflsh simulate scene.yaml` (run_scene, scene_run.hpp) steps it as fast as
+// it can and records frames; `sflsh run scene.yaml --realtime` steps it in
+// time with the wall clock; the browser viewer pushes device poses into it.
+//
+// Scene conventions (documented for users in scene_description.hpp):
+//   * placement P (offset, heading about +Y) is applied to the motion: the
+//     body's targets are P·G(t); with a non-zero `velocity` the placement
+//     travels, P(t) = T(velocity·t)·P, and the body starts with that velocity;
+//   * a body without a motion holds its rest pose with its joint springs but
+//     its root is free (it falls, rolls and comes to rest under contact);
+//   * bodies that collide with another body track their motion's root with a
+//     force limit (body_push_limit × body weight) so that contact, not the
+//     motion, decides where they meet;
+//   * tools follow a pose source — keyframes, a pose file, a live UDP stream
+//     (teleop/stream_message.hpp) or poses pushed with set_device_pose(). A
+//     tool is kinematic (it is where its device puts it) or, with `coupling`,
+//     a dynamic rigid body of the Newton solve pulled to the device by a
+//     spring–damper (virtual coupling, energies/virtual_coupling.hpp). With a
+//     shape it touches every body (SdfContactTerm); with sensors it grasps
+//     (GraspController, AMBF Alg. 3) through one AnchorTerm per body;
+//   * contact: one SdfContactTerm per colliding body–object pair (skin samples
+//     every `sample_spacing`), one CapsuleContactTerm per colliding pair of
+//     bodies (skipped when both are kinematic), and one per body with
+//     self_contact; object–object and tool–object contact is not modelled.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/simulation_run.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/step_report.hpp"
+#include "sflsh/teleop/pose_sample.hpp"
+
+namespace sflsh {
+
+struct SceneSessionOptions {
+  /// Print what building the scene does (mesh bakes, stream ports) to stderr.
+  bool progress = true;
+  /// Folder of baked mesh SDFs ("" = no cache): the CLI passes the default cache.
+  std::string cache_dir;
+  /// Root push limit of bodies in body contact, as a fraction of body weight.
+  double body_push_limit = 0.25;
+  /// Open the UDP ports of tools with a `pose_stream` (false: such tools hold
+  /// their keyframe pose unless poses are pushed with set_device_pose; for
+  /// offline checks of a live scene).
+  bool open_streams = true;
+  /// Record the device poses each tool's steps used into DIR/<tool>.csv
+  /// (teleop/pose_recorder.hpp; "" = no recording). finish_recording() puts
+  /// the files in place.
+  std::string record_dir;
+  /// Replay a recording: every tool follows DIR/<tool>.csv with zero-order
+  /// hold instead of its own pose source (its stream is not opened). Replaying
+  /// a recorded session gives bit-identical trajectories.
+  std::string replay_dir;
+};
+
+/// A tool after the latest step.
+struct SceneToolState {
+  /// The device (pose source) sample the last step drove the tool to.
+  teleop::PoseSample device;
+  /// The tool's pose at the current time (world): the device's for a
+  /// kinematic tool, the coupled rigid body's with a coupling.
+  Isometry pose = Isometry::Identity();
+  /// Force (N) and torque (N·m, about the tool's frame origin) the bodies
+  /// exert on the tool through its contact and anchors (world).
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+  /// What the device is sent: the coupling's force and torque on the device
+  /// (kinematic tool: force/torque above), times haptic_gain, the force
+  /// clamped to max_force (N, N·m, world).
+  Vec3 feedback_force = Vec3::Zero(), feedback_torque = Vec3::Zero();
+  int anchors = 0;           ///< flesh points anchored now
+  double max_stretch = 0;    ///< m, the largest anchor stretch |x_p − a_p|
+  bool live = false;         ///< the pose comes from a stream or set_device_pose()
+};
+
+/// A grasp or release (AMBF Alg. 3).
+struct SceneToolEvent {
+  double time = 0;
+  std::string tool, body, kind;  ///< kind: "grasp" | "release"
+  int points = 0;
+};
+
+class SceneSession {
+ public:
+  /// Builds the scene (reads avatars, motions, materials, bakes meshes, opens
+  /// stream ports). Throws sflsh::Error naming the scene file and the body,
+  /// object or tool on inputs the runtime rejects.
+  explicit SceneSession(const SceneDescription& scene, const SceneSessionOptions& options = {});
+  ~SceneSession();
+  SceneSession(const SceneSession&) = delete;
+  SceneSession& operator=(const SceneSession&) = delete;
+
+  const SceneDescription& scene() const;
+  double dt() const;                ///< s, the solver's step
+  double time() const;              ///< s simulated so far
+  long steps_done() const;
+  /// Scene duration (s): solver.seconds, or the longest body motion.
+  double seconds() const;
+  /// Steps of the whole scene: max(1, round(seconds / dt)).
+  long total_steps() const;
+
+  /// Advances one step: reads the tools' pose sources, grasps/releases,
+  /// steps the model, updates tool states and stream feedback. Throws naming
+  /// the body/object/tool and the step when the state becomes non-finite.
+  const StepReport& advance();
+  const StepReport& last_report() const;
+
+  // Bodies (avatars), in the scene's order.
+  int num_bodies() const;
+  const std::string& body_name(int body) const;
+  const Avatar& avatar(int body) const;
+  /// #V by 3 posed skin (m, world) and soft displacement (m, unposed) of a body.
+  Points body_surface(int body) const;
+  Points body_displacement(int body) const;
+  /// 24 by 3 joint positions (m, world).
+  Points body_joints(int body) const;
+  /// The body's target (motion) pose at time t, placed.
+  BodyPose body_target_pose(int body, double t) const;
+  /// The body's index in simulator().model().
+  int body_model_index(int body) const;
+
+  // Tools.
+  int num_tools() const;
+  const std::string& tool_name(int tool) const;
+  /// Index of the tool named `name`; throws naming the known tools otherwise.
+  int tool_index(const std::string& name) const;
+  const SceneToolState& tool_state(int tool) const;
+  /// Pushes a device pose (world; closure rad) for the next steps: the tool
+  /// follows pushed poses from now on (its keyframes/file are no longer read).
+  /// Throws on a non-finite pose or a zero quaternion.
+  void set_device_pose(int tool, const teleop::PoseSample& sample);
+  /// The UDP port of a tool's pose stream (0 when it has none or streams are closed).
+  int stream_port(int tool) const;
+  /// Closes the recording (record_dir) and renames its files into place;
+  /// returns their paths. Without it the recording leaves nothing behind.
+  std::vector<std::string> finish_recording();
+  /// Stream counters of a tool's live stream ("" when it has none).
+  std::string stream_counters(int tool) const;
+  /// Grasp and release events so far.
+  const std::vector<SceneToolEvent>& tool_events() const;
+
+  /// The result's constant part: every body's skin concatenated (surface,
+  /// faces, body names and offsets), the objects' and tools' surfaces
+  /// (objects first, then the tools with a shape), no frames.
+  SimulationResult result_header() const;
+  /// Current poses of the result_header() objects, in its order (world).
+  std::vector<Isometry> object_poses() const;
+  /// Appends the current state as a frame of `result` (made by result_header();
+  /// `step_ms`: the mean step time since the previous frame).
+  void record_frame(SimulationResult& result, double step_ms) const;
+
+  const Simulator& simulator() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sflsh
