@@ -32,8 +32,9 @@ TEST(FrameCodec, FullThenDeltaDecodeToTheFrames) {
   ViewerFrame f = frame_of(s, 0.25);
   QuantizedSkin sent, seen;
   const std::string full = encode_frame(f, quantize(f, s), s, {7, 3, true, 1}, &sent);
-  EXPECT_EQ(full.size() % 4, 0u);
   DecodedFrame d = decode_frame(full, s, &seen);
+  // Layout: 48-byte header, 4 × (6 + 1) skin bytes (28, aligned), one pose of 7 float32, the JSON.
+  EXPECT_EQ(full.size(), 48u + 28 + 28 + d.info.size());
   EXPECT_EQ(d.kind, kFullFrame);
   EXPECT_EQ(d.number, 7u);
   EXPECT_LE((d.positions - f.positions).cwiseAbs().maxCoeff(), kHalfStep);

@@ -14,8 +14,30 @@ const PARENTS = [-1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 1
 
 // What tests and measurements read (window.sflshViewer).
 const stats = { frames: 0, rendered: 0, bytes: 0, latencies: [], lastInfo: null, scene: null, errors: [],
-                renderedFrame: -1, fps: 0, bandwidth: 0 };
+                renderedFrame: -1, fps: 0, receivedFps: 0, bandwidth: 0, maxU: 0, contactFrames: 0 };
 window.sflshViewer = stats;
+// Page pixel (client coordinates) of world point p (m): for tests that aim the mouse at the tool.
+stats.project = (p) => {
+  const v = new THREE.Vector3(...p).project(camera), r = renderer.domElement.getBoundingClientRect();
+  return [r.left + (v.x + 1) / 2 * r.width, r.top + (1 - v.y) / 2 * r.height];
+};
+// Luminance statistics of the last rendered image: { mean, std, nonBackground } (fraction of pixels).
+stats.pixelStats = () => {
+  const c = renderer.domElement, w = c.width, h = c.height;
+  const tmp = document.createElement('canvas');
+  tmp.width = w; tmp.height = h;
+  const ctx = tmp.getContext('2d');
+  ctx.drawImage(c, 0, 0);
+  const d = ctx.getImageData(0, 0, w, h).data, bg = [0x20, 0x23, 0x2a];
+  let s = 0, s2 = 0, other = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    const l = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
+    s += l; s2 += l * l;
+    if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 30) ++other;
+  }
+  const n = d.length / 4, mean = s / n;
+  return { mean, std: Math.sqrt(Math.max(s2 / n - mean * mean, 0)), nonBackground: other / n };
+};
 
 const view = $('view');
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -151,6 +173,8 @@ function applyFrame(f) {
   }
   const info = f.info;
   stats.lastInfo = info;
+  stats.maxU = Math.max(stats.maxU, info.max_u_mm);
+  if (info.tool && info.tool.contact) ++stats.contactFrames;
   driver = info.driver;
   paused = info.paused;
   showInfo(info);
@@ -169,7 +193,6 @@ function showInfo(info) {
   $('maxu').textContent = info.max_u_mm.toFixed(2);
   $('pause').textContent = info.paused ? 'Run' : 'Pause';
   $('play').textContent = info.paused ? 'Play' : 'Pause';
-  $('stiffval').textContent = info.stiffness.toFixed(2);
   if (!live && document.activeElement !== $('timeline')) {
     $('timeline').value = String(info.t);
     $('ptime').textContent = `${info.t.toFixed(3)} s (frame ${info.frame})`;
@@ -230,12 +253,6 @@ function connect() {
 // Panels' controls.
 $('pause').onclick = () => send({ type: 'pause', paused: !paused });
 $('step').onclick = () => send({ type: 'step' });
-$('reset').onclick = () => send({ type: 'reset' });
-$('stiffness').oninput = () => {
-  const k = Math.pow(10, Number($('stiffness').value));
-  $('stiffval').textContent = k.toFixed(2);
-  send({ type: 'stiffness', scale: k });
-};
 $('play').onclick = () => send({ type: 'pause', paused: !paused });
 $('pstep').onclick = () => send({ type: 'step' });
 $('speed').onchange = () => send({ type: 'speed', speed: Number($('speed').value) });
@@ -262,13 +279,15 @@ function loop(now) {
     pendingLatency = [];
   }
   if (now - fpsT0 >= 1000) {
-    stats.fps = (stats.frames - (stats._f0 ?? 0)) * 1000 / (now - fpsT0);
+    stats.receivedFps = (stats.frames - (stats._f0 ?? 0)) * 1000 / (now - fpsT0);
+    stats.fps = fpsCount * 1000 / (now - fpsT0);
     stats.bandwidth = (stats.bytes - bytes0) / ((now - fpsT0) / 1000);
     stats._f0 = stats.frames;
     bytes0 = stats.bytes;
     fpsT0 = now;
     fpsCount = 0;
     $('fps').textContent = stats.fps.toFixed(1);
+    $('rfps').textContent = stats.receivedFps.toFixed(1);
     $('bw').textContent = (stats.bandwidth / 1e6).toFixed(2);
     const l = stats.latencies.slice(-100).sort((a, b) => a - b);
     if (l.length) $('lat').textContent = l[l.length >> 1].toFixed(1);
