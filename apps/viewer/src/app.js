@@ -40,7 +40,9 @@ stats.pixelStats = () => {
 };
 
 const view = $('view');
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// ?aa=0 turns antialiasing off (software renderers such as headless chromium's SwiftShader draw much faster).
+const params = new URLSearchParams(location.search);
+const renderer = new THREE.WebGLRenderer({ antialias: params.get('aa') !== '0', preserveDrawingBuffer: true });
 renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 view.appendChild(renderer.domElement);
 const scene3 = new THREE.Scene();

@@ -2,7 +2,7 @@
 // no browser download). Run by tests/viewer/browser_e2e_test.cpp and by
 // scripts/viewer_figures.sh:
 //   node apps/viewer/test/e2e.mjs --url http://127.0.0.1:PORT/ --mode live|playback
-//        [--screenshot out.png] [--seconds S] [--drag DX,DY,DZ]
+//        [--screenshot out.png] [--seconds S] [--drag DX,DY,DZ] [--wheel N] [--query ?aa=0]
 // live: waits for frames, Shift-drags the tool by DX,DY,DZ metres (default 0,-0.03,0)
 // in the view plane, holds, and reports what the server sent (contact, max |u|);
 // playback: presses play and checks the time advances. Always: display fps,
@@ -17,6 +17,7 @@ const args = Object.fromEntries(process.argv.slice(2).reduce((a, x, i, all) =>
   (x.startsWith('--') ? [...a, [x.slice(2), all[i + 1]]] : a), []));
 const url = args.url, mode = args.mode || 'live', seconds = Number(args.seconds || 3);
 const drag = (args.drag || '0,-0.03,0').split(',').map(Number);
+const wheel = Number(args.wheel || 0);  // Shift+wheel notches toward the scene after the drag (4 mm each)
 const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const fail = (msg, extra = {}) => { console.log(JSON.stringify({ ok: false, error: msg, ...extra })); process.exit(1); };
@@ -35,7 +36,7 @@ try {
   const consoleErrors = [];
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(String(e)));
-  await page.goto(url, { waitUntil: 'load', timeout: 20000 });
+  await page.goto(url + (args.query || ''), { waitUntil: 'load', timeout: 20000 });
   await page.waitForFunction(() => window.sflshViewer && window.sflshViewer.frames >= 5, { timeout: 20000 })
     .catch(() => fail('no frames within 20 s', { consoleErrors }));
   const info = () => page.evaluate(() => window.sflshViewer.lastInfo);
@@ -56,6 +57,10 @@ try {
       await sleep(25);
     }
     await page.mouse.up();
+    for (let i = 0; i < wheel; ++i) {
+      await page.mouse.wheel({ deltaY: -100 });
+      await sleep(40);
+    }
     await page.keyboard.up('Shift');
     // Hold; the page accumulates what every frame from the server said (contact, max |u|).
     await sleep(seconds * 1000);
