@@ -85,16 +85,14 @@ std::string skip_reason() {
   return "";
 }
 
-const char* kScene = R"(
-solver: {dt: 1/250, seconds: 600, gravity: [0, 0, 0]}
-output: {fps: 30}
-bodies:
-  - {name: base, avatar: box.h5, bones: kinematic}
-tools:
-  - name: probe
-    shape: {type: sphere, radius: 0.006}
-    keyframes: [{time: 0.0, position: [0.0, 0.045, 0.0]}]
-)";
+// The box avatar under a probe tool (sphere of `radius` m) following `keyframes` (YAML list);
+// `seconds` of simulation.
+std::string probe_scene(double seconds, double radius, const std::string& keyframes) {
+  return "solver: {dt: 1/250, seconds: " + std::to_string(seconds) +
+         ", gravity: [0, 0, 0]}\noutput: {fps: 50}\nbodies:\n  - {name: base, avatar: box.h5, bones: kinematic}\n"
+         "tools:\n  - name: probe\n    shape: {type: sphere, radius: " +
+         std::to_string(radius) + "}\n    keyframes: " + keyframes + "\n";
+}
 
 std::string e2e(const std::string& url, const std::string& args) {
   std::string out;
@@ -113,7 +111,7 @@ using BrowserE2E = sflsh::test::BoxAvatarScene;
 
 TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
   if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
-  const std::string scene = write_scene(kScene);
+  const std::string scene = write_scene(probe_scene(600, 0.006, "[{time: 0.0, position: [0.0, 0.045, 0.0]}]"));
   Child server(sflsh::test::sflsh_binary() + " -q run " + scene + " --realtime --serve --port 0 --quiet-status 2>" +
                (dir_ / "run.err").string());
   const std::string url = server.wait_for(std::regex("serving (http://[^ ]+)"));
@@ -133,16 +131,8 @@ TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
 
 TEST_F(BrowserE2E, ViewPlaysAResultFile) {
   if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
-  const std::string scene = write_scene(R"(
-solver: {dt: 1/250, seconds: 0.4, gravity: [0, 0, 0]}
-output: {fps: 50}
-bodies:
-  - {name: base, avatar: box.h5, bones: kinematic}
-tools:
-  - name: probe
-    shape: {type: sphere, radius: 0.005}
-    keyframes: [{time: 0.0, position: [0.0, 0.045, 0.0]}, {time: 0.3, position: [0.0, 0.025, 0.0]}]
-)");
+  const std::string scene = write_scene(
+      probe_scene(0.4, 0.005, "[{time: 0.0, position: [0.0, 0.045, 0.0]}, {time: 0.3, position: [0.0, 0.025, 0.0]}]"));
   const std::string h5 = (dir_ / "r.h5").string();
   std::string out;
   ASSERT_EQ(sflsh::test::run_command(sflsh::test::sflsh_binary() + " -q run " + scene + " --quiet-status --out " + h5 +
