@@ -12,6 +12,7 @@ PACKAGES=(
   python3-numpy python3-scipy python3-h5py
   python3-distributed
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer, ASan, UBSan
+  nlohmann-json3-dev chromium  # the browser viewer: JSON controls; its headless-browser test
 )
 
 missing=()
@@ -20,11 +21,24 @@ for p in "${PACKAGES[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#PACKAGES[@]} Debian packages present"
-  exit 0
+else
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# The browser viewer's page (three.js) and its headless-browser test
+# (puppeteer-core drives Debian's chromium; npm never downloads a browser):
+# `npm ci` from the lockfile, only when node_modules is missing or older than it.
+VIEWER="$(cd "$(dirname "$0")/.." && pwd)/apps/viewer"
+if command -v npm >/dev/null; then
+  if [ ! -f "$VIEWER/node_modules/.package-lock.json" ] || [ "$VIEWER/package-lock.json" -nt "$VIEWER/node_modules/.package-lock.json" ]; then
+    echo "setup: npm ci in apps/viewer (three.js, puppeteer-core)"
+    (cd "$VIEWER" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund)
+  fi
+else
+  echo "setup: npm not found: the viewer page is built without three.js (sflsh run --serve / view will say so)"
+fi

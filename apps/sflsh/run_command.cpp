@@ -21,6 +21,7 @@
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_session.hpp"
+#include "sflsh/viewer/live_viewer.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -32,6 +33,9 @@ struct RunArgs {
   int max_substeps = 10;
   std::string out, tool_log, record, replay, cache_dir;
   bool quiet_status = false;
+  bool serve = false;  // the browser viewer (issue 15)
+  int port = 8080;
+  std::string bind = "127.0.0.1";
 };
 
 /// Per-step rows: time, tool, device and tool positions, the force the
@@ -128,6 +132,12 @@ void run_scene_live(const RunArgs& a) {
       steps_since_frame = 0;
     }
   };
+  std::unique_ptr<viewer::LiveViewer> view;
+  if (a.serve) {
+    view = std::make_unique<viewer::LiveViewer>(session, viewer::ViewerServerOptions{a.bind, a.port},
+                                                std::filesystem::path(a.scene).filename().string());
+    view->install(hooks);
+  }
   LiveRunOptions lo;
   lo.realtime = a.realtime;
   lo.seconds = a.seconds;
@@ -139,6 +149,7 @@ void run_scene_live(const RunArgs& a) {
     status = run_live(session, lo, hooks);
   }
   std::cout << status.describe(a.realtime) << "\n";
+  if (view) std::cout << view->summary() << "\n";
   for (const SceneToolEvent& e : session.tool_events())
     std::printf("tool %s t = %.3f s: %s %d skin points of %s\n", e.tool.c_str(), e.time, e.kind.c_str(), e.points,
                 e.body.c_str());
@@ -184,6 +195,10 @@ const CommandRegistrar reg(45, [](CLI::App& app) {
                   "Drive every tool from FOLDER/<tool>.csv of a --record run (bit-identical trajectories)");
   cmd->add_option("--cache-dir", a->cache_dir, "Cache of baked mesh SDFs (default: $SFLSH_CACHE_DIR or ~/.cache/sflsh)");
   cmd->add_flag("--quiet-status", a->quiet_status, "No status line per second");
+  cmd->add_flag("--serve", a->serve, "Serve the live browser viewer (README: Live viewer); the page drives the first tool");
+  cmd->add_option("--port", a->port, "--serve: TCP port (0 = any free port)")->capture_default_str();
+  cmd->add_option("--bind", a->bind, "--serve: address to listen on; not loopback = a warning (no authentication)")
+      ->capture_default_str();
   cmd->callback([a] { run_scene_live(*a); });
 });
 

@@ -1,0 +1,41 @@
+#pragma once
+// `sflsh run scene.yaml --serve`: a SceneSession shown and driven in the
+// browser. The page's tool poses become the first tool's device poses
+// (SceneSession::set_device_pose, the same interface as the device stream of
+// issue 11); pause/step come from the page; frames go out at the display rate
+// from run_live's per-frame hook, never blocking the physics.
+//
+// Not yet applied live (the page hides them in live mode): reset and the
+// stiffness scale: SceneSession has no API to restart or rescale a material.
+#include <memory>
+#include <string>
+
+#include "sflsh/scene/live_run.hpp"
+#include "sflsh/scene/scene_session.hpp"
+#include "sflsh/viewer/viewer_server.hpp"
+
+namespace sflsh::viewer {
+
+class LiveViewer {
+ public:
+  /// Builds the viewer scene from `session` (its skin, objects, tools) and
+  /// starts the server (prints the URL on stdout). `session` must outlive it.
+  LiveViewer(SceneSession& session, const ViewerServerOptions& options, const std::string& title);
+  ~LiveViewer();
+
+  /// Sets hooks.before_frame (apply the page's controls; hold while paused)
+  /// and hooks.after_frame (publish a frame when one is due).
+  void install(LiveRunHooks& hooks);
+  /// The frame of the session's current state (public for tests).
+  ViewerFrame frame(const LiveRunStatus& status) const;
+  /// One line: frames served, clients, bandwidth, controls applied/ignored,
+  /// the largest |u| seen (mm) and the frames with tool contact.
+  std::string summary() const;
+  ViewerServer& server();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sflsh::viewer

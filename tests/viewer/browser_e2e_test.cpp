@@ -1,0 +1,155 @@
+// The viewer end to end in headless Debian chromium, driven by puppeteer-core
+// (apps/viewer/test/e2e.mjs): `sflsh run --realtime --serve` on the small box
+// avatar with a probe; the page shows frames; a Shift-drag pushes the probe
+// 20 mm down (5 mm into the box); the server's own summary (printed at exit) must
+// report tool contact and a soft displacement that grew; the rendered image
+// is not blank. And `sflsh view` plays a result file: the time advances.
+// Skips with a message when chromium, node or apps/viewer/node_modules is
+// absent (scripts/setup.sh installs them).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+
+#include "scene/box_avatar_fixture.hpp"
+#include "sflsh/viewer/web_assets.hpp"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+
+namespace sflsh::viewer {
+namespace {
+
+/// A child process (sh -c cmd) whose stdout is read line by line.
+class Child {
+ public:
+  explicit Child(const std::string& cmd) {
+    int fd[2];
+    if (pipe(fd) != 0) throw std::runtime_error("pipe");
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(fd[1], 1);
+      close(fd[0]);
+      close(fd[1]);
+      execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(fd[1]);
+    out_ = fdopen(fd[0], "r");
+  }
+  ~Child() {
+    stop();
+    if (out_) fclose(out_);
+  }
+  /// Lines until one matches `re` (returns its first group) or EOF ("").
+  std::string wait_for(const std::regex& re) {
+    char buf[4096];
+    while (fgets(buf, sizeof buf, out_)) {
+      log_ += buf;
+      std::cmatch m;
+      if (std::regex_search(buf, m, re)) return m[1].str();
+    }
+    return "";
+  }
+  /// SIGTERM (a normal end for a live run), then the rest of its stdout.
+  std::string stop() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      char buf[4096];
+      while (fgets(buf, sizeof buf, out_)) log_ += buf;
+      waitpid(pid_, nullptr, 0);
+      pid_ = -1;
+    }
+    return log_;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  FILE* out_ = nullptr;
+  std::string log_;
+};
+
+std::string skip_reason() {
+  const char* env = std::getenv("CHROMIUM");
+  const std::string chromium = env ? env : "/usr/bin/chromium";
+  if (!fs::exists(chromium)) return "chromium not found at " + chromium + " (Debian package chromium; scripts/setup.sh)";
+  if (std::system("command -v node > /dev/null 2>&1") != 0) return "node not found";
+  if (!fs::exists(sflsh::test::source_dir() + "/apps/viewer/node_modules/puppeteer-core"))
+    return "apps/viewer/node_modules absent (scripts/setup.sh runs npm ci)";
+  if (!web_assets_problem().empty()) return web_assets_problem();
+  return "";
+}
+
+// The box avatar under a probe tool (sphere of `radius` m) following `keyframes` (YAML list);
+// `seconds` of simulation.
+std::string probe_scene(double seconds, double radius, const std::string& keyframes) {
+  return "solver: {dt: 1/250, seconds: " + std::to_string(seconds) +
+         ", gravity: [0, 0, 0]}\noutput: {fps: 50}\nbodies:\n  - {name: base, avatar: box.h5, bones: kinematic}\n"
+         "tools:\n  - name: probe\n    shape: {type: sphere, radius: " +
+         std::to_string(radius) + "}\n    keyframes: " + keyframes + "\n";
+}
+
+std::string e2e(const std::string& url, const std::string& args) {
+  std::string out;
+  sflsh::test::run_command("node " + sflsh::test::source_dir() + "/apps/viewer/test/e2e.mjs --url " + url + " " + args +
+                               " 2>&1",
+                           &out);
+  return out;
+}
+
+double number_after(const std::string& text, const std::string& key) {
+  const auto at = text.find(key);
+  return at == std::string::npos ? -1 : std::atof(text.c_str() + at + key.size());
+}
+
+using BrowserE2E = sflsh::test::BoxAvatarScene;
+
+TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
+  if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
+  const std::string scene = write_scene(probe_scene(600, 0.006, "[{time: 0.0, position: [0.0, 0.045, 0.0]}]"));
+  Child server(sflsh::test::sflsh_binary() + " -q run " + scene + " --realtime --serve --port 0 --quiet-status 2>" +
+               (dir_ / "run.err").string());
+  const std::string url = server.wait_for(std::regex("serving (http://[^ ]+)"));
+  ASSERT_FALSE(url.empty()) << server.stop();
+  const std::string png = (dir_ / "live.png").string();
+  const std::string out = e2e(url, "--mode live --drag 0,-0.02,0 --seconds 2 --screenshot " + png);
+  const std::string summary = server.stop();
+  std::printf("%s\n%s", out.c_str(), summary.c_str());
+  EXPECT_NE(out.find("\"ok\":true"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"contact\":true"), std::string::npos) << out;
+  // The server's own account: contact frames and a displacement of more than 1 mm.
+  EXPECT_GT(number_after(summary, "tool contact in "), 0) << summary;
+  EXPECT_GT(number_after(summary, "max |u| "), 1.0) << summary;
+  EXPECT_GT(number_after(out, "\"max_u_mm_after\":"), number_after(out, "\"max_u_mm_before\":") + 1.0) << out;
+  EXPECT_GT(fs::file_size(png), 10000u);
+}
+
+TEST_F(BrowserE2E, ViewPlaysAResultFile) {
+  if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
+  const std::string scene = write_scene(
+      probe_scene(0.4, 0.005, "[{time: 0.0, position: [0.0, 0.045, 0.0]}, {time: 0.3, position: [0.0, 0.025, 0.0]}]"));
+  const std::string h5 = (dir_ / "r.h5").string();
+  std::string out;
+  ASSERT_EQ(sflsh::test::run_command(sflsh::test::sflsh_binary() + " -q run " + scene + " --quiet-status --out " + h5 +
+                                         " 2>&1",
+                                     &out),
+            0)
+      << out;
+  Child server(sflsh::test::sflsh_binary() + " view " + h5 + " --port 0 --speed 0.25 2>/dev/null");
+  const std::string url = server.wait_for(std::regex("serving (http://[^ ]+)"));
+  ASSERT_FALSE(url.empty()) << server.stop();
+  out = e2e(url, "--mode playback --seconds 1");
+  server.stop();
+  std::printf("%s", out.c_str());
+  EXPECT_NE(out.find("\"ok\":true"), std::string::npos) << out;
+  // Playing at speed 0.25 for 1 s moves the clock by about 0.25 s.
+  EXPECT_GT(number_after(out, "\"t_after\":"), 0.1) << out;
+}
+
+}  // namespace
+}  // namespace sflsh::viewer
