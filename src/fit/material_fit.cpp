@@ -218,6 +218,13 @@ MaterialFitResult fit_materials(const Avatar& avatar, const FitParameters& param
   res.fitted = x;
   res.brief_report = summary.BriefReport();
   res.termination = summary.message;
+  {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "residual evaluations %.2f s, Jacobian evaluations %.2f s, linear solver %.2f s",
+                  summary.residual_evaluation_time_in_seconds, summary.jacobian_evaluation_time_in_seconds,
+                  summary.linear_solver_time_in_seconds);
+    res.ceres_seconds = buf;
+  }
   res.converged = summary.termination_type == ceres::CONVERGENCE;
   res.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   res.initial_cost = summary.initial_cost;
@@ -304,11 +311,14 @@ std::string MaterialFitResult::describe() const {
   for (int i = 0; i < singular_values.size(); ++i) o << " " << singular_values[i];
   o << "\n";
   for (const std::string& w : warnings) o << w << "\n";
-  o << std::fixed << std::setprecision(3) << "surface error RMS: " << rms_before * 1e3 << " mm before, " << rms_after * 1e3
-    << " mm after (" << frame_time.size() << " frames, every vertex)\n";
+  const double per_coordinate = 1.0 / std::sqrt(3.0);
+  o << std::fixed << std::setprecision(3) << "surface error RMS per coordinate: " << rms_before * per_coordinate * 1e3
+    << " mm before, " << rms_after * per_coordinate * 1e3 << " mm after (vertex distance RMS " << rms_before * 1e3
+    << " -> " << rms_after * 1e3 << " mm; " << frame_time.size() << " frames, every vertex)\n";
   o << "time: " << seconds << " s wall, " << cpu_seconds << " s CPU; " << iterations << " iterations ("
     << (iterations ? seconds / iterations : 0.0) << " s each); " << simulations << " simulations, "
-    << jacobian_simulations << " with Jacobians; " << ms_per_jacobian << " ms per Jacobian evaluation\n";
+    << jacobian_simulations << " with Jacobians; " << ms_per_simulation << " ms per run without, " << ms_per_jacobian
+    << " ms per Jacobian evaluation; Ceres: " << ceres_seconds << "\n";
   return o.str();
 }
 

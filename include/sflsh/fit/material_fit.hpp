@@ -39,6 +39,7 @@ struct MaterialFitResult {
   std::vector<RegionMaterial> materials;  ///< fitted
   double damping = 0;                     ///< fitted (or the fixed) β, s
   std::string brief_report, termination;  ///< Ceres' Summary::BriefReport() and its message
+  std::string ceres_seconds;              ///< where Ceres' time went (residuals, Jacobians, linear solver)
   bool converged = false;
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;  ///< Ceres cost ½ Σ ρ(|r|²) (m²)
@@ -49,7 +50,9 @@ struct MaterialFitResult {
   /// (analytic: the run with sensitivities; numeric: the 2·#p extra runs).
   double ms_per_simulation = 0, ms_per_jacobian = 0;
   int residuals = 0;
-  /// RMS over all vertices (m) per observed frame, with the initial and the fitted parameters.
+  /// RMS over all vertices of the simulated-to-observed distance (m) per
+  /// observed frame, with the initial and the fitted parameters (per
+  /// coordinate: divide by √3).
   std::vector<double> frame_time, frame_rms_before, frame_rms_after;
   double rms_before = 0, rms_after = 0;  ///< over every frame and vertex (m)
   std::string describe() const;  ///< the fitted values with their uncertainty, warnings, errors

@@ -1,0 +1,125 @@
+// `sflsh fit`: per-region material parameters from observed skin motion
+// (Ceres; issue 12).
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+
+#include "command.hpp"
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/time_step.hpp"
+#include "sflsh/fit/material_fit.hpp"
+#include "sflsh/fit/motion_bones.hpp"
+#include "sflsh/fit/observations.hpp"
+#include "sflsh/io/atomic_output.hpp"
+#include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/material_file.hpp"
+
+namespace sflsh::cli {
+namespace {
+
+struct FitArgs {
+  std::string avatar, observed, motion, params = "young,fung_c", regions = "all", out, plot, material, dt, loss = "none";
+  double damping = 0, fps = 30, noise = 0, loss_scale = 0.003;
+  int vertex_stride = 1, frame_stride = 1, max_iterations = 30;
+  unsigned seed = 1;
+  bool numeric = false, start_at_rest = false;
+};
+
+void run_fit(const FitArgs& a) {
+  require(!a.avatar.empty() && !a.observed.empty() && !a.out.empty(), "fit: give --avatar, --observed and --out");
+  io::check_output_file(a.out, "--out");
+  const std::string plot =
+      a.plot.empty() ? (std::filesystem::path(a.out).replace_extension("").string() + "_error.svg") : a.plot;
+  io::check_output_file(plot, "--plot");
+  require(std::isfinite(a.damping) && a.damping >= 0, "--damping must be >= 0 s, got ", a.damping);
+
+  Avatar avatar = read_avatar(a.avatar);
+  if (!a.material.empty()) apply_material_file(a.material, avatar.materials);
+  Observations obs = read_observations(a.observed, a.fps);
+  check_observation_vertices(obs, int(avatar.surface_rest.rows()), a.avatar);
+  if (obs.bones == "dynamic")
+    std::cerr << "sflsh: warning: " << a.observed
+              << " was simulated with dynamic bones; fit simulates kinematic bones (the motion's, prescribed)\n";
+  const FitParameters params(avatar, a.params, a.regions);
+  const double h = !a.dt.empty() ? parse_time_step(a.dt) : (obs.dt > 0 ? obs.dt : 1.0 / 60.0);
+  const std::vector<int> steps = observation_steps(obs, h);
+
+  const std::string motion_spec = !a.motion.empty() ? a.motion : obs.motion;
+  require(!motion_spec.empty(), a.observed, ": the file names no motion (/meta/motion); give --motion");
+  MotionOptions mo;
+  mo.rest_joints = avatar.joints_rest;
+  mo.builtin_seconds = std::max(steps.back() * h, h);
+  MotionReport mrep;
+  const MotionClip motion = load_motion(motion_spec, mo, &mrep);
+  const BoneSequence bones = motion_bones(avatar, motion, h, steps.back(), a.start_at_rest);
+  if (a.noise > 0) add_gaussian_noise(obs, a.noise, a.seed);
+
+  MaterialFitOptions o;
+  o.vertex_stride = a.vertex_stride;
+  o.frame_stride = a.frame_stride;
+  o.loss = a.loss;
+  o.loss_scale = a.loss_scale;
+  o.numeric = a.numeric;
+  o.max_iterations = a.max_iterations;
+  o.damping = a.damping;
+  o.log = [](const std::string& line) { std::cout << line << std::endl; };
+  std::cout << "fitting " << params.size() << " parameters (" << a.params << " on " << params.regions().size()
+            << " regions) to " << obs.time.size() << " frames of " << a.observed << " (motion " << motion_spec << ", "
+            << steps.back() << " steps of " << h * 1e3 << " ms; residuals on every " << a.vertex_stride
+            << ". vertex and every " << a.frame_stride << ". frame; " << (a.numeric ? "numeric" : "analytic")
+            << " Jacobians; loss " << a.loss << ")\n";
+  const MaterialFitResult r = fit_materials(avatar, params, bones, steps, obs.positions, o);
+  std::cout << r.brief_report << "\n" << "Ceres stopped: " << r.termination << "\n" << r.describe();
+
+  std::vector<std::string> comment = {"sflsh fit --avatar " + a.avatar + " --observed " + a.observed + " --params " +
+                                      a.params + " --regions " + a.regions};
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "surface error RMS %.3f mm -> %.3f mm; Ceres: %s", r.rms_before * 1e3,
+                r.rms_after * 1e3, r.termination.c_str());
+  comment.push_back(buf);
+  if (params.damping_index() >= 0) {
+    std::snprintf(buf, sizeof buf, "fitted damping: %.6g s (pass --damping %.6g to sflsh simulate)", r.damping, r.damping);
+    comment.push_back(buf);
+  }
+  for (const std::string& w : r.warnings) comment.push_back(w);
+  write_fit_error_svg(r, plot, "sflsh fit: " + std::filesystem::path(a.observed).filename().string());
+  write_material_file(a.out, r.materials, comment);
+  std::cout << "wrote " << a.out << " and " << plot << "\n";
+}
+
+const CommandRegistrar reg(75, [](CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  auto* cmd = app.add_subcommand("fit",
+                                 "Fit per-region material parameters (Young's modulus, Fung c, Poisson, damping) so "
+                                 "that simulating the observed motion reproduces the observed skin (Ceres)");
+  cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute`")->required();
+  cmd->add_option("--observed", a->observed,
+                  "Observed skin: a result-layout HDF5 file (/frames/time, /frames/positions in the avatar's surface "
+                  "vertex order) or a .pc2")
+      ->required();
+  cmd->add_option("--motion", a->motion, "Motion that drove the observations (default: the file's /meta/motion)");
+  cmd->add_option("--params", a->params, "Comma-separated: young, fung_c, poisson, damping")->capture_default_str();
+  cmd->add_option("--regions", a->regions, "'all' or comma-separated region names")->capture_default_str();
+  cmd->add_option("--out", a->out, "Fitted material file (YAML, as `sflsh simulate --material` reads)")->required();
+  cmd->add_option("--plot", a->plot, "Per-frame surface error before/after (SVG; default: OUT_error.svg)");
+  cmd->add_option("--material", a->material, "Starting materials (YAML overrides, as simulate --material)");
+  cmd->add_option("--dt", a->dt, "Time step (s; default: the file's /meta/dt, else 1/60)");
+  cmd->add_option("--damping", a->damping, "Soft-tissue damping (s) when 'damping' is not fitted; its start when it is")
+      ->capture_default_str();
+  cmd->add_option("--fps", a->fps, "Frame rate of a .pc2 observation")->capture_default_str();
+  cmd->add_flag("--start-at-rest", a->start_at_rest, "The observed run started at rest (simulate --start-at-rest)");
+  cmd->add_option("--vertex-stride", a->vertex_stride, "Residuals on every n-th vertex")->capture_default_str();
+  cmd->add_option("--frame-stride", a->frame_stride, "Residuals on every n-th observed frame")->capture_default_str();
+  cmd->add_option("--loss", a->loss, "Robust loss per vertex: none, huber, cauchy")->capture_default_str();
+  cmd->add_option("--loss-scale", a->loss_scale, "Where the robust loss bends (m)")->capture_default_str();
+  cmd->add_flag("--numeric", a->numeric, "Jacobians by central differences of whole runs instead of sensitivities");
+  cmd->add_option("--max-iterations", a->max_iterations, "Ceres iterations")->capture_default_str();
+  cmd->add_option("--noise", a->noise, "Add Gaussian noise of this sigma (m) to the observations (synthetic tests)")
+      ->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Seed of --noise")->capture_default_str();
+  cmd->callback([a] { run_fit(*a); });
+});
+
+}  // namespace
+}  // namespace sflsh::cli
