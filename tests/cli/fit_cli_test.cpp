@@ -1,0 +1,91 @@
+// `sflsh fit` end to end on a tiny synthetic avatar: simulate observations with
+// known materials, fit them back, and reject bad input with one line, a
+// non-zero exit and no output file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/scene/material_file.hpp"
+#include "sim/synthetic_avatar.hpp"
+#include "test_support.hpp"
+
+namespace sflsh {
+namespace {
+
+int run(const std::string& args, std::string* out) {
+  return test::run_command(test::sflsh_binary() + " -q " + args, out);
+}
+
+void write_obs(const std::string& path, const std::vector<double>& t, const std::vector<Points>& x) {
+  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
+  f.write("/frames/time", t.data(), long(t.size()), 1);
+  std::vector<double> flat;
+  for (const Points& P : x)
+    for (long v = 0; v < P.rows(); ++v)
+      for (int c = 0; c < 3; ++c) flat.push_back(P(v, c));
+  f.write_nd("/frames/positions", flat.data(), {long(x.size()), x[0].rows(), 3});
+  f.write_string("/meta/motion", "builtin:jump");
+  f.commit();
+}
+
+TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
+  test::TempDir dir;
+  test::SyntheticAvatarOptions so;
+  so.nx = 3, so.ny = 4, so.nz = 3;
+  so.cell = 0.03;
+  so.handles = 10;
+  so.handle_radius = 0.07;
+  Avatar a = test::make_synthetic_avatar(so);
+  for (RegionMaterial& m : a.materials) m.fung_c = 300;
+  const std::string avatar = dir.file("box.h5"), truth = dir.file("truth.yaml"), obs = dir.file("obs.h5");
+  write_avatar(a, avatar);
+  std::vector<RegionMaterial> t = a.materials;
+  t[0].young_along *= 2, t[0].young_through *= 2, t[0].young_around *= 2;
+  t[1].young_along *= 0.5, t[1].young_through *= 0.5, t[1].young_around *= 0.5;
+  write_material_file(truth, t);
+  std::string out;
+  ASSERT_EQ(run("simulate --avatar " + avatar + " --motion builtin:shake --seconds 0.5 --bones kinematic --material " +
+                    truth + " --out " + obs, &out),
+            0)
+      << out;
+  const std::string fitted = dir.file("fitted.yaml"), svg = dir.file("fitted_error.svg");
+  ASSERT_EQ(run("fit --avatar " + avatar + " --observed " + obs + " --params young --out " + fitted, &out), 0) << out;
+  EXPECT_NE(out.find("Ceres Solver Report"), std::string::npos) << out;
+  EXPECT_NE(out.find("iter      cost"), std::string::npos) << out;
+  ASSERT_TRUE(std::filesystem::exists(svg));
+  std::vector<RegionMaterial> back = a.materials;
+  apply_material_file(fitted, back);
+  for (int r = 0; r < 2; ++r) EXPECT_NEAR(back[r].young_along / t[r].young_along, 1.0, 1e-3) << out;
+
+  // Bad input: one line naming the problem, exit code 1, no output.
+  const Points P = a.surface_rest;
+  Points nan = P;
+  nan(2, 0) = std::nan("");
+  write_obs(dir.file("few.h5"), {0.0, 1.0 / 30}, {P.topRows(5), P.topRows(5)});
+  write_obs(dir.file("back.h5"), {0.0, 1.0 / 30, 1.0 / 60}, {P, P, P});
+  write_obs(dir.file("nan.h5"), {0.0, 1.0 / 30}, {P, nan});
+  const std::string common = " --avatar " + avatar + " --out " + dir.file("bad.yaml");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"fit --observed " + dir.file("few.h5") + common, "5 vertices per frame"},
+      {"fit --observed " + dir.file("back.h5") + common, "frame times not increasing"},
+      {"fit --observed " + dir.file("nan.h5") + common, "vertex 2 has a non-finite position"},
+      {"fit --observed " + obs + common + " --regions soft,belly", "unknown region 'belly'"},
+      {"fit --observed " + obs + common + " --params young,stiffness", "unknown parameter 'stiffness'"},
+      {"fit --observed " + dir.file("none.h5") + common, "not found"},
+  };
+  for (const auto& [args, fragment] : cases) {
+    const int code = run(args, &out);
+    EXPECT_EQ(code, 1) << args << "\n" << out;
+    EXPECT_NE(out.find(fragment), std::string::npos) << args << "\n" << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << args << "\n" << out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.yaml"))) << args;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad_error.svg"))) << args;
+  }
+}
+
+}  // namespace
+}  // namespace sflsh
