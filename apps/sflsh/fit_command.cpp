@@ -11,6 +11,7 @@
 #include "sflsh/fit/material_fit.hpp"
 #include "sflsh/fit/motion_bones.hpp"
 #include "sflsh/fit/observations.hpp"
+#include "sflsh/fit/reference_observations.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/scene/material_file.hpp"
@@ -20,13 +21,32 @@ namespace {
 
 struct FitArgs {
   std::string avatar, observed, motion, params = "young,fung_c", regions = "all", out, plot, material, dt, loss = "none";
-  double damping = 0, fps = 30, noise = 0, loss_scale = 0.003;
+  std::string write_reference;
+  double damping = 0, fps = 30, noise = 0, loss_scale = 0.003, seconds = 2;
   int vertex_stride = 1, frame_stride = 1, max_iterations = 30;
   unsigned seed = 1;
   bool numeric = false, start_at_rest = false;
 };
 
+/// `--write-reference`: full-FEM observations of --motion on --avatar (with --material).
+void run_reference(const FitArgs& a) {
+  require(!a.motion.empty(), "fit --write-reference: give --motion");
+  require(std::isfinite(a.seconds) && a.seconds > 0, "--seconds must be > 0, got ", a.seconds);
+  io::check_output_file(a.write_reference, "--write-reference");
+  auto avatar = std::make_shared<Avatar>(read_avatar(a.avatar));
+  if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
+  const double h = a.dt.empty() ? 1.0 / 60.0 : parse_time_step(a.dt);
+  MotionOptions mo;
+  mo.rest_joints = avatar->joints_rest;
+  mo.builtin_seconds = a.seconds;
+  const MotionClip motion = load_motion(a.motion, mo);
+  write_reference_observations(avatar, motion, a.motion, a.seconds, h, a.fps, a.write_reference);
+  std::cout << "wrote " << a.write_reference << " (full-FEM reference, " << a.seconds << " s of " << a.motion
+            << " from rest; fit it with --start-at-rest)\n";
+}
+
 void run_fit(const FitArgs& a) {
+  if (!a.write_reference.empty()) return run_reference(a);
   require(!a.avatar.empty() && !a.observed.empty() && !a.out.empty(), "fit: give --avatar, --observed and --out");
   io::check_output_file(a.out, "--out");
   const std::string plot =
@@ -96,12 +116,11 @@ const CommandRegistrar reg(75, [](CLI::App& app) {
   cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute`")->required();
   cmd->add_option("--observed", a->observed,
                   "Observed skin: a result-layout HDF5 file (/frames/time, /frames/positions in the avatar's surface "
-                  "vertex order) or a .pc2")
-      ->required();
+                  "vertex order) or a .pc2");
   cmd->add_option("--motion", a->motion, "Motion that drove the observations (default: the file's /meta/motion)");
   cmd->add_option("--params", a->params, "Comma-separated: young, fung_c, poisson, damping")->capture_default_str();
   cmd->add_option("--regions", a->regions, "'all' or comma-separated region names")->capture_default_str();
-  cmd->add_option("--out", a->out, "Fitted material file (YAML, as `sflsh simulate --material` reads)")->required();
+  cmd->add_option("--out", a->out, "Fitted material file (YAML, as `sflsh simulate --material` reads)");
   cmd->add_option("--plot", a->plot, "Per-frame surface error before/after (SVG; default: OUT_error.svg)");
   cmd->add_option("--material", a->material, "Starting materials (YAML overrides, as simulate --material)");
   cmd->add_option("--dt", a->dt, "Time step (s; default: the file's /meta/dt, else 1/60)");
@@ -118,6 +137,10 @@ const CommandRegistrar reg(75, [](CLI::App& app) {
   cmd->add_option("--noise", a->noise, "Add Gaussian noise of this sigma (m) to the observations (synthetic tests)")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of --noise")->capture_default_str();
+  cmd->add_option("--write-reference", a->write_reference,
+                  "Instead of fitting: write full-FEM observations of --motion (with --material, --seconds, --dt; "
+                  "frames at --fps) to this file");
+  cmd->add_option("--seconds", a->seconds, "Duration of --write-reference (s)")->capture_default_str();
   cmd->callback([a] { run_fit(*a); });
 });
 
