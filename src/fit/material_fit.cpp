@@ -15,122 +15,12 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
+#include "fit/fit_problem.hpp"
 
 namespace sflsh {
 namespace {
 
-/// One simulation of the current parameters, shared by every residual block
-/// (Ceres evaluates the blocks one after another at the same point).
-class SharedRun {
- public:
-  SharedRun(const Avatar& avatar, const FitParameters& params, const BoneSequence& bones, std::vector<int> steps,
-            std::vector<int> vertices, const MaterialFitOptions& options)
-      : avatar_(avatar), params_(params), bones_(bones), steps_(std::move(steps)), vertices_(std::move(vertices)),
-        options_(options) {}
-
-  /// The run at parameters x (#p), with Jacobians when `jacobian`.
-  const SurfaceRun& get(const double* x, bool jacobian) {
-    const Eigen::Map<const VecX> p(x, params_.size());
-    if (valid_ && p == p_ && (has_jacobian_ || !jacobian)) return run_;
-    valid_ = false;
-    Timer timer;
-    if (!jacobian || !options_.numeric) {
-      run_ = simulate_surface(avatar_, params_, p, options_.damping, bones_, steps_, vertices_, jacobian);
-      ++simulations;
-      if (jacobian) ++jacobian_simulations, ms_jacobian += timer.ms();
-      else ++plain_simulations, ms_plain += timer.ms();
-    } else {
-      // Central differences of whole runs: 2 runs per parameter.
-      run_ = simulate_surface(avatar_, params_, p, options_.damping, bones_, steps_, vertices_, false);
-      ms_plain += timer.ms();
-      ++simulations, ++plain_simulations;
-      timer.reset();
-      const int P = params_.size();
-      run_.jacobian.assign(steps_.size(), MatX::Zero(3 * run_.surface[0].rows(), P));
-      for (int i = 0; i < P; ++i) {
-        VecX pp = p, pm = p;
-        pp[i] += options_.numeric_step;
-        pm[i] -= options_.numeric_step;
-        const SurfaceRun a = simulate_surface(avatar_, params_, pp, options_.damping, bones_, steps_, vertices_, false);
-        const SurfaceRun b = simulate_surface(avatar_, params_, pm, options_.damping, bones_, steps_, vertices_, false);
-        simulations += 2;
-        for (size_t f = 0; f < steps_.size(); ++f) {
-          const MatXr d = (a.surface[f] - b.surface[f]) / (2 * options_.numeric_step);
-          run_.jacobian[f].col(i) = Eigen::Map<const VecX>(d.data(), d.size());
-        }
-      }
-      ++jacobian_simulations;
-      ms_jacobian += timer.ms();
-    }
-    p_ = p;
-    has_jacobian_ = jacobian;
-    valid_ = true;
-    return run_;
-  }
-
-  int simulations = 0, plain_simulations = 0, jacobian_simulations = 0;
-  double ms_plain = 0, ms_jacobian = 0;
-
- private:
-  const Avatar& avatar_;
-  const FitParameters& params_;
-  const BoneSequence& bones_;
-  std::vector<int> steps_, vertices_;
-  const MaterialFitOptions& options_;
-  VecX p_;
-  bool valid_ = false, has_jacobian_ = false;
-  SurfaceRun run_;
-};
-
-/// Residual x_v(t_f; p) − observed (3, m) of one vertex in one frame.
-class VertexCost : public ceres::CostFunction {
- public:
-  VertexCost(SharedRun* run, int frame, int vertex, const Vec3& observed, int num_params)
-      : run_(run), frame_(frame), vertex_(vertex), observed_(observed) {
-    set_num_residuals(3);
-    mutable_parameter_block_sizes()->push_back(num_params);
-  }
-  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
-    const bool want = jacobians != nullptr && jacobians[0] != nullptr;
-    try {
-      const SurfaceRun& r = run_->get(x[0], want);
-      for (int c = 0; c < 3; ++c) residuals[c] = r.surface[frame_](vertex_, c) - observed_[c];
-      if (want) {
-        const MatX& J = r.jacobian[frame_];
-        const int P = int(J.cols());
-        for (int c = 0; c < 3; ++c)
-          for (int j = 0; j < P; ++j) jacobians[0][c * P + j] = J(3 * vertex_ + c, j);
-      }
-      return true;
-    } catch (const Error&) {
-      return false;  // e.g. an element inverted: Ceres shrinks its trust region
-    }
-  }
-
- private:
-  SharedRun* run_;
-  int frame_, vertex_;
-  Vec3 observed_;
-};
-
-/// One line per Ceres iteration, in the style of its own progress output.
-class ProgressLog : public ceres::IterationCallback {
- public:
-  explicit ProgressLog(std::function<void(const std::string&)> log) : log_(std::move(log)) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (!log_) return ceres::SOLVER_CONTINUE;
-    char buf[256];
-    if (s.iteration == 0) log_("iter      cost        cost_change  |gradient|   |step|    tr_radius  iter_time  total_time");
-    std::snprintf(buf, sizeof buf, "%4d  %12.6e  %11.3e  %10.3e  %9.3e  %9.3e  %8.2f s  %9.2f s%s", s.iteration, s.cost,
-                  s.cost_change, s.gradient_max_norm, s.step_norm, s.trust_region_radius, s.iteration_time_in_seconds,
-                  s.cumulative_time_in_seconds, s.iteration > 0 && !s.step_is_successful ? "  (rejected)" : "");
-    log_(buf);
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  std::function<void(const std::string&)> log_;
-};
+using namespace fit_detail;
 
 /// Per observed frame RMS over the vertices of simulated − observed (m).
 std::vector<double> frame_rms(const SurfaceRun& run, const std::vector<Points>& observed) {
@@ -158,17 +48,14 @@ MaterialFitResult fit_materials(const Avatar& avatar, const FitParameters& param
   require(steps.size() == observed.size() && !steps.empty(), "fit: ", steps.size(), " steps for ", observed.size(),
           " observed frames");
   require(o.vertex_stride >= 1 && o.frame_stride >= 1, "fit: vertex and frame strides must be >= 1");
-  require(o.loss == "none" || o.loss == "huber" || o.loss == "cauchy", "--loss must be none, huber or cauchy, got '",
-          o.loss, "'");
-  require(o.loss_scale > 0 && std::isfinite(o.loss_scale), "--loss-scale must be > 0 m, got ", o.loss_scale);
   require(o.max_iterations >= 0, "--max-iterations must be >= 0");
   const int V = int(avatar.surface_rest.rows()), P = params.size();
   for (const Points& X : observed)
     require(X.rows() == V, "fit: an observed frame has ", X.rows(), " vertices, the avatar ", V);
 
-  std::vector<int> frames, fit_steps, vertices;
-  for (size_t f = 0; f < steps.size(); f += o.frame_stride) frames.push_back(int(f)), fit_steps.push_back(steps[f]);
-  for (int v = 0; v < V; v += o.vertex_stride) vertices.push_back(v);
+  const std::vector<int> frames = strided(int(steps.size()), o.frame_stride), vertices = strided(V, o.vertex_stride);
+  std::vector<int> fit_steps;
+  for (int f : frames) fit_steps.push_back(steps[f]);
 
   MaterialFitResult res;
   for (const FitParameter& e : params.entries()) res.labels.push_back(e.label(avatar.materials));
@@ -183,32 +70,16 @@ MaterialFitResult fit_materials(const Avatar& avatar, const FitParameters& param
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(po);
-  std::unique_ptr<ceres::LossFunction> loss;
-  if (o.loss == "huber") loss = std::make_unique<ceres::HuberLoss>(o.loss_scale);
-  if (o.loss == "cauchy") loss = std::make_unique<ceres::CauchyLoss>(o.loss_scale);
-  for (size_t f = 0; f < frames.size(); ++f)
-    for (size_t i = 0; i < vertices.size(); ++i)
-      problem.AddResidualBlock(
-          new VertexCost(&shared, int(f), int(i), observed[frames[f]].row(vertices[i]).transpose(), P), loss.get(),
-          x.data());
+  const std::unique_ptr<ceres::LossFunction> loss = make_loss(o);
+  add_vertex_blocks(problem, shared, frames, vertices, observed, P, VecX(), loss.get(), {x.data()});
   for (int i = 0; i < P; ++i) {
     problem.SetParameterLowerBound(x.data(), i, lower[i]);
     problem.SetParameterUpperBound(x.data(), i, upper[i]);
   }
   res.residuals = problem.NumResiduals();
 
-  ceres::Solver::Options so;
-  so.minimizer_type = ceres::TRUST_REGION;
-  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  so.max_num_iterations = o.max_iterations;
-  so.function_tolerance = o.function_tolerance;
-  so.gradient_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-6;
-  so.num_threads = 1;  // blocks share one simulation: evaluate them in order
-  so.logging_type = ceres::SILENT;
   ProgressLog progress(o.log);
-  so.callbacks.push_back(&progress);
+  const ceres::Solver::Options so = solver_options(o, &progress);
   ceres::Solver::Summary summary;
   const std::clock_t cpu0 = std::clock();
   Timer wall;
