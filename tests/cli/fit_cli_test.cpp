@@ -87,5 +87,52 @@ TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
   }
 }
 
+TEST(FitCli, DatasetMapAndItsMaterialsForANewShape) {
+  // Three "shapes" of the tiny box (same mesh, betas -1, 0.5, 1.5) whose
+  // Young's factors follow exp(P0 + beta P1); fit the map, evaluate it at beta 2.
+  test::TempDir dir;
+  test::SyntheticAvatarOptions so;
+  so.nx = 3, so.ny = 4, so.nz = 3;
+  so.cell = 0.03;
+  so.handles = 10;
+  so.handle_radius = 0.07;
+  const double P0[2] = {0.3, -0.2}, P1[2] = {0.2, -0.15};
+  std::string yaml = "subjects:\n", out;
+  auto shape = [&](double beta, const std::string& name) {
+    Avatar a = test::make_synthetic_avatar(so);
+    a.betas = VecX::Constant(1, beta);
+    write_avatar(a, dir.file(name + ".h5"));
+    return a;
+  };
+  for (double beta : {-1.0, 0.5, 1.5}) {
+    const std::string name = "box" + std::to_string(int(10 * beta));
+    const Avatar a = shape(beta, name);
+    std::vector<RegionMaterial> t = a.materials;
+    for (int r = 0; r < 2; ++r) {
+      const double f = std::exp(P0[r] + beta * P1[r]);
+      t[r].young_along *= f, t[r].young_through *= f, t[r].young_around *= f;
+    }
+    write_material_file(dir.file(name + "_truth.yaml"), t);
+    ASSERT_EQ(run("simulate --avatar " + dir.file(name + ".h5") + " --motion builtin:shake --seconds 0.4 --bones kinematic "
+                  "--material " + dir.file(name + "_truth.yaml") + " --out " + dir.file(name + "_obs.h5"), &out), 0) << out;
+    yaml += "  - {avatar: " + name + ".h5, observed: " + name + "_obs.h5}\n";
+  }
+  std::ofstream(dir.file("fits.yaml")) << yaml;
+  ASSERT_EQ(run("fit --dataset " + dir.file("fits.yaml") + " --params young --regularization 1e-12 --leave-one-out --out " +
+                dir.file("map.yaml"), &out), 0) << out;
+  EXPECT_NE(out.find("leave-one-out"), std::string::npos) << out;
+  const Avatar b2 = shape(2.0, "new");
+  ASSERT_EQ(run("fit --map " + dir.file("map.yaml") + " --avatar " + dir.file("new.h5") + " --out " + dir.file("new.yaml"), &out), 0) << out;
+  std::vector<RegionMaterial> m = b2.materials;
+  apply_material_file(dir.file("new.yaml"), m);
+  for (int r = 0; r < 2; ++r)
+    EXPECT_NEAR(m[r].young_along / b2.materials[r].young_along, std::exp(P0[r] + 2.0 * P1[r]), 5e-3) << out;
+  // A map's parameter for a region the avatar lacks is one clear error.
+  std::ofstream(dir.file("bad_map.yaml")) << "parameters:\n  - {name: \"young:belly\", p0: 0, pk: [0]}\n";
+  EXPECT_EQ(run("fit --map " + dir.file("bad_map.yaml") + " --avatar " + dir.file("new.h5") + " --out " + dir.file("x.yaml"), &out), 1);
+  EXPECT_NE(out.find("region 'belly'"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.yaml")));
+}
+
 }  // namespace
 }  // namespace sflsh
