@@ -36,6 +36,14 @@ double total_rms(const std::vector<double>& per_frame) {
   return per_frame.empty() ? 0 : std::sqrt(s / per_frame.size());
 }
 
+/// A 1-sigma factor exp(σ) as text ("x1.23", or "> x1000" past that).
+std::string sigma_factor(double sigma) {
+  if (!(sigma < std::log(1000.0))) return "> x1000";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "x%.3g", std::exp(sigma));
+  return buf;
+}
+
 bool is_log(const FitParameter& p) {
   return p.kind == FitParameter::Kind::Young || p.kind == FitParameter::Kind::FungC;
 }
@@ -147,7 +155,7 @@ MaterialFitResult fit_materials(const Avatar& avatar, const FitParameters& param
     for (int i = 0; i < P; ++i)
       if (is_log(params.entries()[i]) && res.std_error[i] > 0.5)
         res.warnings.push_back("warning: " + res.labels[i] + " is poorly identified (1-sigma factor " +
-                               std::to_string(std::exp(res.std_error[i])) + ")");
+                               sigma_factor(res.std_error[i]) + ")");
   }
   res.materials = params.materials(avatar.materials, x);
   res.damping = params.damping(x, o.damping);
@@ -170,7 +178,10 @@ std::string MaterialFitResult::describe() const {
   for (size_t i = 0; i < labels.size(); ++i) {
     const bool log = labels[i].rfind("young:", 0) == 0 || labels[i].rfind("fung_c:", 0) == 0;
     char buf[200];
-    if (log)
+    if (log && std_error[i] > std::log(10.0))
+      std::snprintf(buf, sizeof buf, "  %-22s x%-8.4f (start x%.4f)  1-sigma factor %s\n", labels[i].c_str(),
+                    std::exp(fitted[i]), std::exp(initial[i]), sigma_factor(std_error[i]).c_str());
+    else if (log)
       std::snprintf(buf, sizeof buf, "  %-22s x%-8.4f (start x%.4f)  ±%.2f%%\n", labels[i].c_str(), std::exp(fitted[i]),
                     std::exp(initial[i]), 100 * (std::exp(std_error[i]) - 1));
     else

@@ -8,9 +8,8 @@
 #include <fstream>
 
 #include "sflsh/asset/avatar_file.hpp"
-#include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/scene/material_file.hpp"
-#include "sim/synthetic_avatar.hpp"
+#include "fit/fit_fixture.hpp"
 #include "test_support.hpp"
 
 namespace sflsh {
@@ -20,27 +19,9 @@ int run(const std::string& args, std::string* out) {
   return test::run_command(test::sflsh_binary() + " -q " + args, out);
 }
 
-void write_obs(const std::string& path, const std::vector<double>& t, const std::vector<Points>& x) {
-  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
-  f.write("/frames/time", t.data(), long(t.size()), 1);
-  std::vector<double> flat;
-  for (const Points& P : x)
-    for (long v = 0; v < P.rows(); ++v)
-      for (int c = 0; c < 3; ++c) flat.push_back(P(v, c));
-  f.write_nd("/frames/positions", flat.data(), {long(x.size()), x[0].rows(), 3});
-  f.write_string("/meta/motion", "builtin:jump");
-  f.commit();
-}
-
 TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
   test::TempDir dir;
-  test::SyntheticAvatarOptions so;
-  so.nx = 3, so.ny = 4, so.nz = 3;
-  so.cell = 0.03;
-  so.handles = 10;
-  so.handle_radius = 0.07;
-  Avatar a = test::make_synthetic_avatar(so);
-  for (RegionMaterial& m : a.materials) m.fung_c = 300;
+  const Avatar a = test::fit_avatar();
   const std::string avatar = dir.file("box.h5"), truth = dir.file("truth.yaml"), obs = dir.file("obs.h5");
   write_avatar(a, avatar);
   std::vector<RegionMaterial> t = a.materials;
@@ -65,9 +46,9 @@ TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
   const Points P = a.surface_rest;
   Points nan = P;
   nan(2, 0) = std::nan("");
-  write_obs(dir.file("few.h5"), {0.0, 1.0 / 30}, {P.topRows(5), P.topRows(5)});
-  write_obs(dir.file("back.h5"), {0.0, 1.0 / 30, 1.0 / 60}, {P, P, P});
-  write_obs(dir.file("nan.h5"), {0.0, 1.0 / 30}, {P, nan});
+  test::write_observation_file(dir.file("few.h5"), {0.0, 1.0 / 30}, {P.topRows(5), P.topRows(5)});
+  test::write_observation_file(dir.file("back.h5"), {0.0, 1.0 / 30, 1.0 / 60}, {P, P, P});
+  test::write_observation_file(dir.file("nan.h5"), {0.0, 1.0 / 30}, {P, nan});
   const std::string common = " --avatar " + avatar + " --out " + dir.file("bad.yaml");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"fit --observed " + dir.file("few.h5") + common, "5 vertices per frame"},
@@ -91,15 +72,10 @@ TEST(FitCli, DatasetMapAndItsMaterialsForANewShape) {
   // Three "shapes" of the tiny box (same mesh, betas -1, 0.5, 1.5) whose
   // Young's factors follow exp(P0 + beta P1); fit the map, evaluate it at beta 2.
   test::TempDir dir;
-  test::SyntheticAvatarOptions so;
-  so.nx = 3, so.ny = 4, so.nz = 3;
-  so.cell = 0.03;
-  so.handles = 10;
-  so.handle_radius = 0.07;
   const double P0[2] = {0.3, -0.2}, P1[2] = {0.2, -0.15};
   std::string yaml = "subjects:\n", out;
   auto shape = [&](double beta, const std::string& name) {
-    Avatar a = test::make_synthetic_avatar(so);
+    Avatar a = test::fit_avatar();
     a.betas = VecX::Constant(1, beta);
     write_avatar(a, dir.file(name + ".h5"));
     return a;

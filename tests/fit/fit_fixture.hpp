@@ -4,7 +4,11 @@
 // of 3 cm, 10 hat handles, two regions (x < 0 "soft", x ≥ 0 "firm") with a low
 // Fung constant so that saturation acts at the strains the motion reaches.
 // The motion: the pelvis bobs 3 cm and the chain bends 0.6 rad.
+#include <string>
+#include <vector>
+
 #include "sflsh/fit/trajectory_sensitivity.hpp"
+#include "sflsh/io/hdf5_file.hpp"
 #include "sim/synthetic_avatar.hpp"
 
 namespace sflsh::test {
@@ -27,6 +31,21 @@ inline BoneSequence fit_bones(const Avatar& a, int steps) {
   seq.bones_before = synthetic_motion(a, -seq.h, 0.03, 0.6);
   for (int s = 0; s <= steps; ++s) seq.bones.push_back(synthetic_motion(a, s * seq.h, 0.03, 0.6));
   return seq;
+}
+
+/// An observation file in the result layout: /frames/time, /frames/positions
+/// (each frame #V by 3) and /meta/motion.
+inline void write_observation_file(const std::string& path, const std::vector<double>& t, const std::vector<Points>& x,
+                                   const std::string& motion = "builtin:jump") {
+  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
+  f.write("/frames/time", t.data(), long(t.size()), 1);
+  std::vector<double> flat;
+  for (const Points& P : x)
+    for (long v = 0; v < P.rows(); ++v)
+      for (int c = 0; c < 3; ++c) flat.push_back(P(v, c));
+  f.write_nd("/frames/positions", flat.data(), {long(x.size()), x[0].rows(), 3});
+  f.write_string("/meta/motion", motion);
+  f.commit();
 }
 
 }  // namespace sflsh::test

@@ -8,7 +8,6 @@
 #include "fit_fixture.hpp"
 #include "sflsh/fit/material_fit.hpp"
 #include "sflsh/fit/observations.hpp"
-#include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/scene/material_file.hpp"
 #include "test_support.hpp"
 
@@ -120,26 +119,15 @@ TEST(MaterialFile, RoundTripOfDistinctValues) {
   EXPECT_FALSE(std::filesystem::exists(path + ".partial"));
 }
 
-void write_obs(const std::string& path, const std::vector<double>& t, const std::vector<Points>& x) {
-  io::Hdf5File f(path, io::Hdf5File::Mode::Write);
-  f.write("/frames/time", t.data(), long(t.size()), 1);
-  std::vector<double> flat;
-  for (const Points& P : x)
-    for (long v = 0; v < P.rows(); ++v)
-      for (int c = 0; c < 3; ++c) flat.push_back(P(v, c));
-  f.write_nd("/frames/positions", flat.data(), {long(x.size()), x[0].rows(), 3});
-  f.commit();
-}
-
 TEST(Observations, BadInputIsOneClearError) {
   test::TempDir dir;
   const Points P = Points::Zero(5, 3);
   const std::string ok = dir.file("ok.h5"), back = dir.file("back.h5"), nan = dir.file("nan.h5");
-  write_obs(ok, {0.0, 1.0 / 30}, {P, P});
-  write_obs(back, {0.0, 0.1, 0.1}, {P, P, P});
+  test::write_observation_file(ok, {0.0, 1.0 / 30}, {P, P});
+  test::write_observation_file(back, {0.0, 0.1, 0.1}, {P, P, P});
   Points Q = P;
   Q(3, 1) = std::nan("");
-  write_obs(nan, {0.0, 0.1}, {P, Q});
+  test::write_observation_file(nan, {0.0, 0.1}, {P, Q});
   const Observations o = read_observations(ok);
   EXPECT_EQ(o.positions.size(), 2u);
   test::expect_error([&] { check_observation_vertices(o, 6, "a.h5"); }, {"5 vertices", "a.h5", "6 surface vertices"});
