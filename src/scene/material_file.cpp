@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "sflsh/core/error.hpp"
 
@@ -78,6 +79,28 @@ void apply_material_file(const std::string& path, std::vector<RegionMaterial>& m
       fail(where(path, kv.first), ": unknown top-level key '", key, "' (expected 'all' or 'regions')");
     }
   }
+}
+
+void write_material_file(const std::string& path, const std::vector<RegionMaterial>& materials,
+                         const std::vector<std::string>& comment) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream f(partial);
+    if (!f) fail(path, ": cannot write the material file");
+    f.precision(17);
+    for (const std::string& c : comment) f << "# " << c << "\n";
+    f << "regions:\n";
+    for (const RegionMaterial& m : materials)
+      f << "  " << m.name << ": {young_along: " << m.young_along << ", young_through: " << m.young_through
+        << ", young_around: " << m.young_around << ", poisson: " << m.poisson << ", fung_c: " << m.fung_c
+        << ", density: " << m.density << "}\n";
+    f.close();
+    if (!f) {
+      std::filesystem::remove(partial);
+      fail(path, ": write failed");
+    }
+  }
+  std::filesystem::rename(partial, path);
 }
 
 }  // namespace sflsh

@@ -21,4 +21,12 @@ namespace sflsh {
 /// Applies the overrides in `path` to `materials` (by region name).
 void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials);
 
+/// Writes every region of `materials` under `regions:` with all its keys
+/// (young_along, young_through, young_around, poisson, fung_c, density; 17
+/// significant digits, so apply_material_file reads back the same doubles),
+/// after `comment` lines (each prefixed with "# "). Written as path.partial
+/// and renamed: nothing is left at `path` on failure.
+void write_material_file(const std::string& path, const std::vector<RegionMaterial>& materials,
+                         const std::vector<std::string>& comment = {});
+
 }  // namespace sflsh

@@ -6,6 +6,7 @@
 
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/sim/energies/sample_hessian.hpp"
 
 namespace sflsh {
 
@@ -29,30 +30,6 @@ const RegionMaterial& tet_material(const Avatar& a, int t) {
           a.materials.size(), ")");
   return a.materials[r];
 }
-
-namespace {
-
-/// hess(z-block) += Gᵀ Hw G for a sample whose F depends on the handles
-/// `handle[0..m)` through `d[0..m)`: G(a + 3b, 3e + c) = δ_ac d_e[b], so
-///   T_e = Σ_b d_e[b] Hw(3b..3b+2, :)  (3x9),  block(e, f) = Σ_b' T_e(:, 3b'..) d_f[b'],
-/// ~27 m² flops instead of a dense 9 by 3m product.
-void add_sample_hessian(const Mat9& Hw, const int* handle, const Vec3* d, int m, int z0, MatRef hess,
-                        std::vector<Eigen::Matrix<double, 3, 9>>& T) {
-  T.resize(m);
-  for (int e = 0; e < m; ++e)
-    T[e] = d[e][0] * Hw.middleRows<3>(0) + d[e][1] * Hw.middleRows<3>(3) + d[e][2] * Hw.middleRows<3>(6);
-  for (int e = 0; e < m; ++e) {
-    const int row = z0 + 3 * handle[e];
-    for (int f = e; f < m; ++f) {
-      const Mat3 block = d[f][0] * T[e].leftCols<3>() + d[f][1] * T[e].middleCols<3>(3) + d[f][2] * T[e].rightCols<3>();
-      const int col = z0 + 3 * handle[f];
-      hess.block<3, 3>(row, col) += block;
-      if (f != e) hess.block<3, 3>(col, row) += block.transpose();
-    }
-  }
-}
-
-}  // namespace
 
 ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic)
     : num_reduced_(a.num_reduced()), project_psd_(project_psd), exact_quadratic_(exact_quadratic) {

@@ -1,0 +1,24 @@
+#include "sflsh/fit/motion_bones.hpp"
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/scene/simulation_run.hpp"
+
+namespace sflsh {
+
+BoneSequence motion_bones(const Avatar& avatar, const MotionClip& motion, double h, int steps, bool start_at_rest) {
+  require(h > 0 && steps >= 0, "motion_bones: need h > 0 and steps >= 0");
+  BoneSequence seq;
+  seq.h = h;
+  for (int s = 0; s <= steps; ++s) seq.bones.push_back(target_bones(avatar, motion.sample(s * h)));
+  if (start_at_rest) {
+    seq.bones_before = seq.bones[0];
+  } else {
+    // As run_simulation: q_{-1} = Δ⁻¹ q_0 with Δ = G(h) G(0)⁻¹ per bone.
+    const std::vector<Isometry> next = target_bones(avatar, motion.sample(h));
+    for (size_t j = 0; j < next.size(); ++j)
+      seq.bones_before.push_back(seq.bones[0][j] * next[j].inverse() * seq.bones[0][j]);
+  }
+  return seq;
+}
+
+}  // namespace sflsh
