@@ -9,8 +9,10 @@
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
+#include "sflsh/core/progress.hpp"
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/input_file.hpp"
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/precompute/file_betas_avatar.hpp"
 #include "sflsh/scene/material_file.hpp"
@@ -43,9 +45,10 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   if (!a.exp.empty()) scene.output.export_path = a.exp;
   if (!a.render.empty()) scene.output.render = a.render;
   const OutputDescription& out = scene.output;
-  io::check_output_file(out.out, "output.out");
-  if (!out.render.empty()) io::check_output_file(out.render, "output.render");
-  if (!out.export_path.empty()) io::check_output_file(out.export_path, "output.export");
+  // Named as the user gave them: the flag, or the scene's key.
+  io::check_output_file(out.out, out_given ? "--out" : "output.out");
+  if (!out.render.empty()) io::check_output_file(out.render, a.render.empty() ? "output.render" : "--render");
+  if (!out.export_path.empty()) io::check_output_file(out.export_path, a.exp.empty() ? "output.export" : "--export");
   SceneRunOptions o;
   o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
   SceneContactStats stats;
@@ -90,6 +93,8 @@ void run_simulate(const SimulateArgs& a) {
   require(std::isfinite(a.speed) && a.speed > 0, "--speed must be positive, got ", a.speed);
   require(std::isfinite(a.start) && a.start >= 0, "--start must be >= 0 s, got ", a.start);
   require(std::isfinite(a.end), "--end must be a number of seconds, got ", a.end);
+  require(a.render_frames >= 1 && a.render_frames <= 1000, "--render-frames must be in [1, 1000], got ", a.render_frames);
+  if (!a.resume.empty()) io::require_input_file(a.resume, "--resume");
   o.seconds = a.seconds;
   o.output_fps = a.output_fps;
   o.start_at_rest = a.start_at_rest;
@@ -131,7 +136,7 @@ void run_simulate(const SimulateArgs& a) {
     motion = load_motion(a.motion, mo, &mrep);
   }
   if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
-  std::cerr << mrep.describe();
+  log_info(mrep.describe());  // not with --quiet: then an error is the only line
 
   // Frames stream into the result file; exports and the picture read it back.
   // SIGINT/SIGTERM stop the run between steps; the writer's partial file is
@@ -194,7 +199,9 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--start", a->start, "Motion start time (s)");
   cmd->add_option("--end", a->end, "Motion end time (s)");
   cmd->add_option("--speed", a->speed, "Motion playback speed factor")->capture_default_str();
-  cmd->add_option("--units", a->units, "BVH length unit: cm|m|inch|auto")->capture_default_str();
+  cmd->add_option("--units", a->units, "BVH/assimp length unit: auto, m, cm, mm, inch, cmu")
+      ->check(CLI::IsMember({"auto", "m", "cm", "mm", "inch", "cmu"}))
+      ->capture_default_str();
   cmd->add_option("--joint-map", a->joint_map, "Joint-name map file for BVH/FBX skeletons ('source smpl' per line)");
   cmd->add_flag("--use-file-betas", a->use_file_betas,
                 "AMASS .npz motions: simulate an avatar of the file's 'betas' (same body model and handle count as "

@@ -71,6 +71,9 @@ MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionRe
   r.source = spec;
   require(o.speed > 0 && std::isfinite(o.speed), spec, ": --speed must be positive, got ", o.speed);
   require(o.fps >= 0 && std::isfinite(o.fps), spec, ": --fps must be positive (or 0 to keep the file's), got ", o.fps);
+  require(o.start >= 0 && std::isfinite(o.start), spec, ": --start must be a time >= 0 s, got ", o.start);
+  require(o.end < 0 || (std::isfinite(o.end) && o.end > o.start), spec,
+          ": --end must be a time after --start (s; default: the end), got ", o.end);
   MotionClip clip;
   const std::string ext = io::lower_extension(spec);
   if (spec.rfind("builtin:", 0) == 0) {
