@@ -32,6 +32,7 @@ struct SimulateArgs {
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
+  long inject_nan_at_step = 0;  // test only (hidden option)
   bool line_search = false, use_file_betas = false, start_at_rest = false;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
 };
@@ -100,6 +101,8 @@ void run_simulate(const SimulateArgs& a) {
   o.start_at_rest = a.start_at_rest;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
+  require(a.inject_nan_at_step >= 0, "--inject-nan-at-step must be >= 0");
+  o.inject_nan_at_step = a.inject_nan_at_step;
   // Check every output can be written before spending time simulating.
   io::check_output_file(a.out, "--out");
   if (!a.render.empty()) io::check_output_file(a.render, "--render");
@@ -146,10 +149,17 @@ void run_simulate(const SimulateArgs& a) {
     const InterruptScope interrupt_scope;
     try {
       ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
-      SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+      SimulationResult r;
+      try {
+        r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+      } catch (SimulationStopped& e) {
+        r = std::move(e.partial);  // the numerical guard: keep the frames made, marked incomplete
+      }
       r.avatar = avatar_name;
       throw_if_interrupted("after the last step");
       writer.finish(r);
+      if (r.incomplete)
+        fail(r.stop_reason, "; wrote the ", writer.num_frames(), " frames before it to ", a.out, " (marked incomplete)");
       std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
     } catch (const Interrupted& e) {
       const std::string partial = a.out + ".partial";
@@ -215,6 +225,10 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
+  // Test only, hidden from --help: drives the run into the numerical guard.
+  cmd->add_option("--inject-nan-at-step", a->inject_nan_at_step,
+                  "TEST ONLY: a NaN motion target at step N (the run must stop there, result marked incomplete)")
+      ->group("");
   cmd->callback([a, seconds, cmd] {
     a->seconds_given = seconds->count() > 0;
     if (!a->scene.empty()) {

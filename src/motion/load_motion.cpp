@@ -62,6 +62,20 @@ MotionClip retarget_file(const SkeletonMotion& sk, const MotionOptions& o, Motio
   return clip;
 }
 
+// Every format: a frame holding a NaN/Inf rotation or translation is one
+// error naming the frame and the joint (a NaN frame must not reach a run).
+void require_finite_frames(const MotionClip& clip) {
+  for (int f = 0; f < clip.num_frames(); ++f) {
+    const double t = f / clip.fps;
+    require(clip.translations[f].allFinite(), clip.name, ": frame ", f, " (t = ", t,
+            " s): the root translation is not finite; motions with non-finite frames are rejected");
+    for (size_t j = 0; j < clip.rotations[f].size(); ++j)
+      require(clip.rotations[f][j].coeffs().allFinite(), clip.name, ": frame ", f, " (t = ", t, " s): joint ",
+              j < kSmplJointNames.size() ? std::string(kSmplJointNames[j]) : std::to_string(j),
+              " rotation is not finite; motions with non-finite frames are rejected");
+  }
+}
+
 }  // namespace
 
 MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionReport* report) {
@@ -100,6 +114,7 @@ MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionRe
     }
   }
   clip.name = spec;
+  require_finite_frames(clip);
   r.source_frames = clip.num_frames();
   r.source_fps = clip.fps;
   if (o.drop_first_frame_jump && (r.format == "bvh" || r.format == "assimp")) {
