@@ -35,9 +35,15 @@ void run_bench(const BenchArgs& a) {
   o.model = a.model;
   if (!a.betas.empty()) o.betas = parse_betas(a.betas);
   if (!a.handles.empty()) {
-    const VecX k = parse_betas(a.handles);  // same comma-separated number syntax
+    VecX k;
+    try {
+      k = parse_betas(a.handles);  // same comma-separated number syntax
+    } catch (const Error&) {
+      fail("--handles '", a.handles, "': expected comma-separated whole numbers like 16,32,64");
+    }
     for (Eigen::Index i = 0; i < k.size(); ++i) {
-      require(k[i] >= 1 && k[i] == std::floor(k[i]), "--handles: '", k[i], "' is not a positive whole number");
+      require(k[i] >= 1 && k[i] <= 2000 && k[i] == std::floor(k[i]), "--handles: '", k[i],
+              "' is not a whole number in [1, 2000] (as precompute --handles)");
       o.handle_counts.push_back(int(k[i]));
     }
   }

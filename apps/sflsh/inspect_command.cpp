@@ -1,11 +1,15 @@
-// `sflsh inspect avatar.h5 [--json]`: what an avatar file holds and its quality figures.
+// `sflsh inspect FILE [--json]`: what an avatar file holds and its quality
+// figures, or (a result file) what a simulation result holds, incomplete or not.
 #include <cstdio>
 #include <iostream>
 #include <sstream>
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/input_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
+#include "sflsh/scene/result_file.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -15,7 +19,28 @@ struct InspectArgs {
   bool json = false;
 };
 
+/// A result file (it has /frames): its summary; "incomplete" when the run stopped early.
+bool inspect_result(const InspectArgs& args) {
+  bool is_result = false;
+  {
+    const io::Hdf5File f(args.path, io::Hdf5File::Mode::Read);
+    is_result = f.has("/frames") && f.has("/meta/format_version");
+  }
+  if (!is_result) return false;
+  const SimulationResult r = read_simulation_result(args.path);
+  if (args.json) {
+    std::printf("{\"file\": \"result\", \"frames\": %d, \"steps\": %zu, \"incomplete\": %s}\n", int(r.frame_time.size()),
+                r.step_time.size(), r.incomplete ? "true" : "false");
+  } else {
+    std::printf("%s: simulation result, %d frames, %zu steps, %s\n", args.path.c_str(), int(r.frame_time.size()),
+                r.step_time.size(), r.incomplete ? ("INCOMPLETE (" + r.stop_reason + ")").c_str() : "complete");
+  }
+  return true;
+}
+
 void run_inspect(const InspectArgs& args) {
+  io::require_input_file(args.path, "");
+  if (inspect_result(args)) return;
   const Avatar avatar = read_avatar(args.path);
   const AvatarSummary s = summarize_avatar(avatar);
   std::cout << (args.json ? s.to_json() : s.to_text(args.path));
@@ -23,8 +48,8 @@ void run_inspect(const InspectArgs& args) {
 
 const CommandRegistrar reg(30, [](CLI::App& app) {
   auto args = std::make_shared<InspectArgs>();
-  auto* cmd = app.add_subcommand("inspect", "Print what an avatar file holds and its quality figures");
-  cmd->add_option("avatar", args->path, "Avatar HDF5 file written by `sflsh precompute`")->required();
+  auto* cmd = app.add_subcommand("inspect", "Print what an avatar file holds and its quality figures, or a result file's frames and whether it is complete");
+  cmd->add_option("avatar", args->path, "Avatar HDF5 file written by `sflsh precompute`, or a result file of `sflsh simulate`")->required();
   cmd->add_flag("--json", args->json, "Machine-readable output");
   cmd->callback([args] { run_inspect(*args); });
 });

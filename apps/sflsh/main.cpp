@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
   app.add_flag_callback("-q,--quiet", [] { sflsh::Progress::set_quiet(true); }, "Print no progress");
   app.set_version_flag("--version", std::string("sflsh ") + "0.1.0");
   sflsh::cli::setup_commands(app);
+  // A parse error is one line, like every other error (CLI11's default adds a
+  // second "Run with --help" line).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("sflsh: error: ") + e.what() + " (see --help)\n";
+  });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,6 +1,7 @@
 // `sflsh motion info FILE` and `sflsh motion export FILE --out poses.npz`:
 // what a motion file holds (joints, frames, rate, mapping to SMPL) and its SMPL
 // pose parameters as an AMASS-like .npz.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -33,8 +34,16 @@ void add_load_options(CLI::App* cmd, MotionArgs& a) {
   cmd->add_option("--seconds", a.options.builtin_seconds, "Length of built-in motions (s)");
 }
 
+/// The command's own numbers, checked before anything is read.
+void check_load_options(const MotionArgs& a) {
+  require(std::isfinite(a.options.builtin_seconds) && a.options.builtin_seconds > 0,
+          "--seconds must be a positive number of seconds, got ", a.options.builtin_seconds);
+}
+
 void export_npz(const MotionArgs& a) {
   require(io::lower_extension(a.out) == ".npz", a.out, ": --out must be a .npz file");
+  io::check_output_file(a.out, "--out");
+  check_load_options(a);
   const MotionClip clip = load_motion(a.file, a.options);
   if (const auto parent = std::filesystem::path(a.out).parent_path(); !parent.empty())
     std::filesystem::create_directories(parent);
@@ -52,6 +61,7 @@ CommandRegistrar reg(60, [](CLI::App& app) {
   add_load_options(info, *args);
   info->add_flag("--json", args->json, "Print JSON instead of text");
   info->callback([args] {
+    check_load_options(*args);
     MotionReport report;
     load_motion(args->file, args->options, &report);
     std::fputs((args->json ? report.to_json() + "\n" : report.describe()).c_str(), stdout);

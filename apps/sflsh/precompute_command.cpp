@@ -2,6 +2,7 @@
 #include <stdlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -49,6 +50,9 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
   if (!a.handles_file.empty()) o.handle_positions = read_handles_file(a.handles_file);
   if (!a.thickness_map.empty()) o.thickness = read_thickness_map(a.thickness_map);
   if (!a.no_cache) o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
+  for (const auto& [flag, v] : {std::pair<const char*, double>{"--cell-size", a.cell_size},
+                                {"--facet-size", a.facet_size}, {"--facet-distance", a.facet_distance}})
+    require(std::isfinite(v) && v >= 0 && v <= 1, flag, " must be a length in (0, 1] m (or 0 for the default), got ", v);
   if (a.cell_size > 0) o.template_stage.mesh.cell_size = a.cell_size;
   if (a.facet_size > 0) o.template_stage.mesh.facet_size = a.facet_size;
   if (a.facet_distance > 0) o.template_stage.mesh.facet_distance = a.facet_distance;
@@ -167,9 +171,6 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   const std::vector<BatchShape> shapes = read_batch_shapes(a.batch, model.num_betas());
   require(a.task_index < int(shapes.size()), a.batch, ": --task-index ", a.task_index, " but the file has ",
           shapes.size(), " data rows (task indices 0 to ", shapes.size() - 1, ")");
-  std::error_code ec;
-  std::filesystem::create_directories(a.out_dir, ec);
-  if (ec) fail(a.out_dir, ": cannot create output folder: ", ec.message());
   const std::string manifest = a.manifest.empty() ? default_manifest(a, shard) : a.manifest;
 
   Timer wall;
@@ -180,6 +181,17 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   auto report_failure = [&](const BatchRecord& r) {
     std::cerr << "batch: row " << r.row << " (" << a.batch << " line " << r.line << ") failed: " << r.error << "\n";
   };
+  int invalid = 0;
+  for (const BatchRecord& r : records) invalid += r.status == "failed";
+  // No valid row at all: a bad input file, one error line (not a table).
+  if (invalid > 0 && invalid == int(records.size())) {
+    const auto first = std::find_if(records.begin(), records.end(), [](const BatchRecord& r) { return r.status == "failed"; });
+    fail(a.batch, " line ", first->line, ": ", first->error, invalid > 1 ? " (and " + std::to_string(invalid - 1) +
+         " more invalid rows; no valid row to build)" : " (no valid row to build)");
+  }
+  std::error_code ec;  // made only now: a file with no valid row leaves no folder
+  std::filesystem::create_directories(a.out_dir, ec);
+  if (ec) fail(a.out_dir, ": cannot create output folder: ", ec.message());
   for (const BatchRecord& r : records)
     if (r.status == "failed") report_failure(r);
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));

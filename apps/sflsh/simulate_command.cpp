@@ -10,8 +10,10 @@
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
+#include "sflsh/core/progress.hpp"
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/input_file.hpp"
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/precompute/file_betas_avatar.hpp"
 #include "sflsh/scene/material_file.hpp"
@@ -31,6 +33,7 @@ struct SimulateArgs {
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
+  long inject_nan_at_step = 0;  // test only (hidden option)
   bool line_search = false, use_file_betas = false, start_at_rest = false;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
   double tracking_tolerance_mm = 20;
@@ -62,9 +65,10 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   if (!a.exp.empty()) scene.output.export_path = a.exp;
   if (!a.render.empty()) scene.output.render = a.render;
   const OutputDescription& out = scene.output;
-  io::check_output_file(out.out, "output.out");
-  if (!out.render.empty()) io::check_output_file(out.render, "output.render");
-  if (!out.export_path.empty()) io::check_output_file(out.export_path, "output.export");
+  // Named as the user gave them: the flag, or the scene's key.
+  io::check_output_file(out.out, out_given ? "--out" : "output.out");
+  if (!out.render.empty()) io::check_output_file(out.render, a.render.empty() ? "output.render" : "--render");
+  if (!out.export_path.empty()) io::check_output_file(out.export_path, a.exp.empty() ? "output.export" : "--export");
   SceneRunOptions o;
   o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
   SceneContactStats stats;
@@ -109,11 +113,15 @@ void run_simulate(const SimulateArgs& a) {
   require(std::isfinite(a.speed) && a.speed > 0, "--speed must be positive, got ", a.speed);
   require(std::isfinite(a.start) && a.start >= 0, "--start must be >= 0 s, got ", a.start);
   require(std::isfinite(a.end), "--end must be a number of seconds, got ", a.end);
+  require(a.render_frames >= 1 && a.render_frames <= 1000, "--render-frames must be in [1, 1000], got ", a.render_frames);
+  if (!a.resume.empty()) io::require_input_file(a.resume, "--resume");
   o.seconds = a.seconds;
   o.output_fps = a.output_fps;
   o.start_at_rest = a.start_at_rest;
   o.checkpoint = a.checkpoint;
   o.resume = a.resume;
+  require(a.inject_nan_at_step >= 0, "--inject-nan-at-step must be >= 0");
+  o.inject_nan_at_step = a.inject_nan_at_step;
   // Check every output can be written before spending time simulating.
   io::check_output_file(a.out, "--out");
   if (!a.render.empty()) io::check_output_file(a.render, "--render");
@@ -150,7 +158,7 @@ void run_simulate(const SimulateArgs& a) {
     motion = load_motion(a.motion, mo, &mrep);
   }
   if (!a.material.empty()) apply_material_file(a.material, avatar->materials);
-  std::cerr << mrep.describe();
+  log_info(mrep.describe());  // not with --quiet: then an error is the only line
 
   // Frames stream into the result file; exports and the picture read it back.
   // SIGINT/SIGTERM stop the run between steps; the writer's partial file is
@@ -160,10 +168,17 @@ void run_simulate(const SimulateArgs& a) {
     const InterruptScope interrupt_scope;
     try {
       ResultWriter writer(a.out, avatar->surface_faces, avatar->surface_rest, avatar->num_reduced());
-      SimulationResult r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+      SimulationResult r;
+      try {
+        r = run_simulation(avatar, motion, o, [&](const FrameData& f) { writer.add_frame(f); });
+      } catch (SimulationStopped& e) {
+        r = std::move(e.partial);  // the numerical guard: keep the frames made, marked incomplete
+      }
       r.avatar = avatar_name;
       throw_if_interrupted("after the last step");
       writer.finish(r);
+      if (r.incomplete)
+        fail(r.stop_reason, "; wrote the ", writer.num_frames(), " frames before it to ", a.out, " (marked incomplete)");
       std::cout << r.describe() << "wrote " << a.out << " (" << writer.num_frames() << " frames)\n";
       check_tracking(r, a);
     } catch (const Interrupted& e) {
@@ -214,7 +229,9 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--start", a->start, "Motion start time (s)");
   cmd->add_option("--end", a->end, "Motion end time (s)");
   cmd->add_option("--speed", a->speed, "Motion playback speed factor")->capture_default_str();
-  cmd->add_option("--units", a->units, "BVH length unit: cm|m|inch|auto")->capture_default_str();
+  cmd->add_option("--units", a->units, "BVH/assimp length unit: auto, m, cm, mm, inch, cmu")
+      ->check(CLI::IsMember({"auto", "m", "cm", "mm", "inch", "cmu"}))
+      ->capture_default_str();
   cmd->add_option("--joint-map", a->joint_map, "Joint-name map file for BVH/FBX skeletons ('source smpl' per line)");
   cmd->add_flag("--use-file-betas", a->use_file_betas,
                 "AMASS .npz motions: simulate an avatar of the file's 'betas' (same body model and handle count as "
@@ -233,6 +250,10 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
+  // Test only, hidden from --help: drives the run into the numerical guard.
+  cmd->add_option("--inject-nan-at-step", a->inject_nan_at_step,
+                  "TEST ONLY: a NaN motion target at step N (the run must stop there, result marked incomplete)")
+      ->group("");
   cmd->callback([a, seconds, cmd] {
     a->seconds_given = seconds->count() > 0;
     if (!a->scene.empty()) {

@@ -25,6 +25,7 @@ struct StreamArgs {
 };
 
 void run_stream_listen(const StreamArgs& a) {
+  require(a.port >= 0 && a.port <= 65535, "--port ", a.port, ": expected 0 (pick a free one) or 1..65535");
   require(a.rate > 0.0 && a.rate <= 1e5, "--rate ", a.rate, ": expected a loop rate in (0, 1e5] Hz");
   require(a.seconds >= 0.0, "--seconds ", a.seconds, ": expected >= 0 (0 = until Ctrl-C)");
   require(a.max_speed > 0.0, "--max-speed ", a.max_speed, ": expected > 0 m/s");

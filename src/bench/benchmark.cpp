@@ -219,6 +219,12 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   std::sort(o.handle_counts.begin(), o.handle_counts.end());
 
   const BodyModel model = load_body_model(o.model);
+  // The motion first, on the shape's skeleton (as the avatar's), so that a bad
+  // motion file fails before minutes of precompute.
+  MotionOptions mo;
+  mo.rest_joints = regress_joints(model, shape_vertices(model, o.betas));
+  mo.builtin_seconds = o.seconds + 0.5;
+  const MotionClip motion = load_motion(o.motion, mo);
   const TemplateVolume tv = cached_template_volume(model, o.precompute);
   std::vector<std::shared_ptr<const Avatar>> avatars;
   std::shared_ptr<const Avatar> default_avatar;
@@ -230,10 +236,6 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     if (K == o.default_handles) default_avatar = avatars.back();
   }
   const Avatar& base = *default_avatar;
-  MotionOptions mo;
-  mo.rest_joints = base.joints_rest;
-  mo.builtin_seconds = o.seconds + 0.5;
-  const MotionClip motion = load_motion(o.motion, mo);
   const std::vector<int> region = simulated_region(base);
   const VecXi labels = vertex_regions(base, region);
   const int num_regions = int(base.materials.size());

@@ -11,6 +11,16 @@
 namespace sflsh {
 namespace {
 
+// A NaN/Inf in a (T, D) per-frame array: one error naming the key, the frame
+// (0-based, and its time at `fps`) and the column.
+void require_finite_frames(const io::NpyArray& a, const std::string& path, const std::string& key, double fps) {
+  const std::int64_t cols = a.shape.size() == 2 ? a.shape[1] : 1;
+  for (size_t i = 0; i < a.data.size(); ++i)
+    if (!std::isfinite(a.data[i]))
+      fail(path, ": key '", key, "' frame ", std::int64_t(i) / cols, " (t = ", double(std::int64_t(i) / cols) / fps,
+           " s), column ", std::int64_t(i) % cols, " is ", a.data[i], "; motions with non-finite frames are rejected");
+}
+
 // AMASS world (Z up) -> SMPL/sflsh world (Y up): R_x(-90°).
 Eigen::Quaterniond z_up_to_y_up() { return Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitX())); }
 
@@ -56,7 +66,7 @@ MotionClip read_amass(const std::string& path, const Points& rest_joints, AmassI
     const auto D = poses->shape[1];
     require(D % 3 == 0 && D >= 66, path, ": key 'poses' has shape (", poses->shape[0], ", ", D,
             "), expected (T, 156) (SMPL+H), (T, 72) (SMPL) or (T, 3K) with K >= 22 joints");
-    poses->require_finite(path, "poses");
+    require_finite_frames(*poses, path, "poses", fps);
     T = poses->shape[0];
     joints = D == 72 ? 24 : 22;
     out.layout = "poses";
@@ -72,8 +82,8 @@ MotionClip read_amass(const std::string& path, const Points& rest_joints, AmassI
     root->require_shape({-1, 3}, path, "root_orient");
     T = root->shape[0];
     body->require_shape({T, 63}, path, "pose_body");
-    root->require_finite(path, "root_orient");
-    body->require_finite(path, "pose_body");
+    require_finite_frames(*root, path, "root_orient", fps);
+    require_finite_frames(*body, path, "pose_body", fps);
     out.layout = "root_orient+pose_body";
     out.pose_columns = 66;
     aa.resize(size_t(T) * 66);
@@ -86,7 +96,7 @@ MotionClip read_amass(const std::string& path, const Points& rest_joints, AmassI
   const io::NpyArray* trans = get("trans");
   require(trans != nullptr, path, ": missing key 'trans': expected shape (", T, ", 3); keys present: ", keys());
   trans->require_shape({T, 3}, path, "trans");
-  trans->require_finite(path, "trans");
+  require_finite_frames(*trans, path, "trans", fps);
 
   if (const io::NpyArray* betas = get("betas")) {
     betas->require_finite(path, "betas");

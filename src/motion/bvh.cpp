@@ -251,7 +251,7 @@ void parse_motion(Scanner& sc, BvhMotion& m, size_t text_size) {
   if (frames < 1 || frames > kMaxFrames)
     sc.error("'Frames: " + std::to_string(frames) + "': expected 1 to " + std::to_string(kMaxFrames));
   if (sc.next() != "Frame") sc.error("expected 'Frame Time:' after the 'Frames:' line");
-  const double dt = sc.number(labelled_value(sc, "Time:", "after 'Frame'"), "a frame time in seconds");
+  const double dt = sc.number(labelled_value(sc, "Time:", "after 'Frame'"), "'Frame Time' in seconds");
   if (!(dt > 0)) sc.error("'Frame Time' must be positive, found " + std::to_string(dt));
   sc.expect_end_of_line("the frame time");
   m.num_frames = int(frames);

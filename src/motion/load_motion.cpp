@@ -62,6 +62,20 @@ MotionClip retarget_file(const SkeletonMotion& sk, const MotionOptions& o, Motio
   return clip;
 }
 
+// Every format: a frame holding a NaN/Inf rotation or translation is one
+// error naming the frame and the joint (a NaN frame must not reach a run).
+void require_finite_frames(const MotionClip& clip) {
+  for (int f = 0; f < clip.num_frames(); ++f) {
+    const double t = f / clip.fps;
+    require(clip.translations[f].allFinite(), clip.name, ": frame ", f, " (t = ", t,
+            " s): the root translation is not finite; motions with non-finite frames are rejected");
+    for (size_t j = 0; j < clip.rotations[f].size(); ++j)
+      require(clip.rotations[f][j].coeffs().allFinite(), clip.name, ": frame ", f, " (t = ", t, " s): joint ",
+              j < kSmplJointNames.size() ? std::string(kSmplJointNames[j]) : std::to_string(j),
+              " rotation is not finite; motions with non-finite frames are rejected");
+  }
+}
+
 }  // namespace
 
 MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionReport* report) {
@@ -71,6 +85,9 @@ MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionRe
   r.source = spec;
   require(o.speed > 0 && std::isfinite(o.speed), spec, ": --speed must be positive, got ", o.speed);
   require(o.fps >= 0 && std::isfinite(o.fps), spec, ": --fps must be positive (or 0 to keep the file's), got ", o.fps);
+  require(o.start >= 0 && std::isfinite(o.start), spec, ": --start must be a time >= 0 s, got ", o.start);
+  require(o.end < 0 || (std::isfinite(o.end) && o.end > o.start), spec,
+          ": --end must be a time after --start (s; default: the end), got ", o.end);
   MotionClip clip;
   const std::string ext = io::lower_extension(spec);
   if (spec.rfind("builtin:", 0) == 0) {
@@ -97,6 +114,7 @@ MotionClip load_motion(const std::string& spec, const MotionOptions& o, MotionRe
     }
   }
   clip.name = spec;
+  require_finite_frames(clip);
   r.source_frames = clip.num_frames();
   r.source_fps = clip.fps;
   if (o.drop_first_frame_jump && (r.format == "bvh" || r.format == "assimp")) {

@@ -9,6 +9,7 @@
 
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/io/input_file.hpp"
 
 namespace sflsh {
 namespace {
@@ -119,6 +120,7 @@ JointMap builtin_joint_map(const std::string& name) {
 }
 
 JointMap read_joint_map(const std::string& path) {
+  io::require_input_file(path, "joint map");
   std::ifstream in(path);
   require(bool(in), path, ": cannot open joint map file");
   JointMap map{path, {}};

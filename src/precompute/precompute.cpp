@@ -15,6 +15,7 @@
 #include "sflsh/core/memory.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/io/input_file.hpp"
 
 namespace sflsh {
 
@@ -179,6 +180,7 @@ Avatar precompute_avatar(const BodyModel& model, const VecX& betas, const Precom
 }
 
 Points read_handles_file(const std::string& path) {
+  io::require_input_file(path, "handles file");
   std::ifstream in(path);
   if (!in) fail(path, ": cannot open handles file");
   std::vector<Vec3> pts;

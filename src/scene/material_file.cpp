@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/io/input_file.hpp"
 
 namespace sflsh {
 namespace {
@@ -51,7 +52,7 @@ void apply(const std::string& path, const YAML::Node& params, RegionMaterial& m)
 }  // namespace
 
 void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials) {
-  if (!std::filesystem::exists(path)) fail(path, ": material file not found");
+  io::require_input_file(path, "material file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

@@ -109,7 +109,8 @@ std::vector<geometry::PrimitiveMesh> object_display_meshes(const SimulationResul
   return out;
 }
 
-std::string export_result(const SimulationResult& r, const std::string& path) {
+// The export itself; export_result() adds the incomplete note.
+static std::string export_frames(const SimulationResult& r, const std::string& path) {
   require(!r.frame_positions.empty(), path, ": the simulation has no frames to export");
   const std::filesystem::path p(path);
   const std::vector<geometry::PrimitiveMesh> objects = object_display_meshes(r);
@@ -149,6 +150,11 @@ std::string export_result(const SimulationResult& r, const std::string& path) {
   for (size_t f = 0; f < r.frame_positions.size(); ++f)
     io::write_mesh(io::format_frame_path(path, int(f)), merged_frame(r, objects, f), F);
   return "wrote " + std::to_string(r.frame_positions.size()) + " meshes " + path + merged_note(r);
+}
+
+std::string export_result(const SimulationResult& r, const std::string& path) {
+  const std::string line = export_frames(r, path);
+  return r.incomplete ? line + " [INCOMPLETE result: the run stopped early]" : line;
 }
 
 void render_result(const SimulationResult& r, const std::string& path, int num_frames) {

@@ -170,6 +170,13 @@ void ResultWriter::add_frame(const FrameData& fr) {
   require(fr.reduced.size() == num_reduced_, at, ": reduced has ", fr.reduced.size(), " entries, expected ", num_reduced_);
   require(fr.object_poses.size() == object_names_.size(), at, ": ", fr.object_poses.size(), " object poses for ",
           object_names_.size(), " objects");
+  // Last line of defence: a result file never holds NaN/Inf (the run's guard,
+  // sim/finite_guard.hpp, stops before such a frame is made).
+  for (const auto& [name, ok] : {std::pair<const char*, bool>{"positions", fr.positions.allFinite()},
+                                 {"displacement", fr.displacement.allFinite()}, {"joints", fr.joints.allFinite()},
+                                 {"reduced", fr.reduced.allFinite()}, {"target_pelvis", fr.target_pelvis.allFinite()},
+                                 {"time", std::isfinite(fr.time)}})
+    require(ok, at, ": ", name, " holds a non-finite value; not written");
   std::vector<double> poses(7 * object_names_.size());
   for (size_t o = 0; o < object_names_.size(); ++o)
     pose_to_row(fr.object_poses[o], &poses[7 * o], at + ": the pose of object '" + object_names_[o] + "'");
@@ -193,6 +200,8 @@ void ResultWriter::finish(const SimulationResult& r) {
   f.write_scalar("/meta/dt", r.dt);
   f.write_string("/meta/bones", r.bones_dynamic ? "dynamic" : "kinematic");
   f.write_scalar("/meta/newton_iters", std::int64_t(r.newton_iters));
+  f.write_scalar("/meta/incomplete", std::int64_t(r.incomplete ? 1 : 0));
+  if (r.incomplete) f.write_string("/meta/stop_reason", r.stop_reason);
   const std::int64_t S = r.step_time.size();
   f.write_nd("/steps/time", r.step_time.data(), {S});
   f.write_nd("/steps/energy", r.step_energy.data(), {S});
@@ -238,6 +247,12 @@ SimulationResult read_simulation_result(const std::string& path) {
   r.dt = f.read_scalar("/meta/dt");
   r.bones_dynamic = f.read_string("/meta/bones") == "dynamic";
   r.newton_iters = int(f.read_scalar("/meta/newton_iters"));
+  if (f.has("/meta/incomplete")) {  // absent in files written before it existed: complete
+    const double inc = f.read_scalar("/meta/incomplete");
+    require(inc == 0 || inc == 1, path, ": dataset /meta/incomplete is ", inc, ", expected 0 or 1");
+    r.incomplete = inc == 1;
+    if (r.incomplete && f.has("/meta/stop_reason")) r.stop_reason = f.read_string("/meta/stop_reason");
+  }
   r.faces = f.read_int_matrix("/surface/faces", -1, 3);
   r.surface_rest = f.read_matrix("/surface/rest", -1, 3);
   const std::int64_t V = r.surface_rest.rows();

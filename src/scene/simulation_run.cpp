@@ -5,21 +5,22 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
+#include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/sim/skeleton_pose.hpp"
 #include "sflsh/sim/state_file.hpp"
 
 namespace sflsh {
 namespace {
 
-bool finite_state(const Configuration& q) {
-  if (!q.z.allFinite()) return false;
-  for (const auto& b : q.bones)
+bool finite_configuration(const std::vector<Isometry>& bones) {
+  for (const auto& b : bones)
     if (!b.matrix().allFinite()) return false;
   return true;
 }
@@ -77,6 +78,7 @@ std::string SimulationResult::describe() const {
       o << (i ? ", " : " ") << part_names[i] << " " << part_ms[i] / double(step_ms.size());
     o << "\n";
   }
+  if (incomplete) o << "INCOMPLETE: the run stopped early: " << stop_reason << "\n";
   if (pelvis_frames > 0)
     o << std::setprecision(1) << "pelvis vs motion root: mean " << pelvis_error_mean * 1e3 << " mm, max "
       << pelvis_error_max * 1e3 << " mm over " << pelvis_frames << " frames\n";
@@ -166,9 +168,28 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     const double t = (s + 1) * h;
     const BodyPose pose = motion.sample(t);
     targets = target_bones(*avatar, pose);
-    const StepReport rep = sim.step(targets, pose);
-    if (!finite_state(sim.state()) || !std::isfinite(rep.energy_after))
-      fail(motion.name, ": simulation state became non-finite at step ", s + 1, " (t = ", t, " s); try a smaller --dt");
+    if (s + 1 == options.inject_nan_at_step)  // test only: a NaN target bone (the pose terms check their own input)
+      targets[0].translation().x() = std::numeric_limits<double>::quiet_NaN();
+    auto stop = [&](const std::string& why) {
+      if (options.progress) progress.finish();
+      r.incomplete = true;
+      r.stop_reason = why;
+      throw SimulationStopped(why, std::move(r));
+    };
+    StepReport rep;
+    try {
+      rep = sim.step(targets, pose);
+      require_finite_step(sim.model(), sim.scene_state(), rep, s + 1, motion.name);
+    } catch (const NonFiniteError& e) {
+      stop(e.what());
+    } catch (const Error& e) {
+      // The Newton step refuses a non-finite configuration itself (before any term is named).
+      if (finite_configuration(targets)) throw;
+      std::ostringstream why;
+      why << motion.name << ": non-finite value at step " << s + 1 << " (t = " << t << " s): body '"
+          << sim.model().bodies().at(0).name << "': a target bone is not finite (" << e.what() << "); stopped";
+      stop(why.str());
+    }
     r.add_step(t, rep);
     ms_since_frame += rep.ms_total;
     ++steps_since_frame;

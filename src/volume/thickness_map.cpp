@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/io/input_file.hpp"
 #include "sflsh/volume/body_regions.hpp"
 
 namespace sflsh {
@@ -23,11 +24,12 @@ ThicknessMap ThicknessMap::defaults() {
 ThicknessMap ThicknessMap::uniform() { return ThicknessMap{}; }
 
 ThicknessMap read_thickness_map(const std::string& path) {
+  io::require_input_file(path, "thickness map");
   std::ifstream in(path);
   require(bool(in), path, ": cannot open thickness map");
   ThicknessMap map = ThicknessMap::defaults();
   std::string line;
-  int lineno = 0;
+  int lineno = 0, entries = 0;
   while (std::getline(in, line)) {
     ++lineno;
     const auto hash = line.find('#');
@@ -54,7 +56,10 @@ ThicknessMap read_thickness_map(const std::string& path) {
     require(std::isfinite(s) && s > 0 && s <= 3, path, ":", lineno, ": scale ", s, " of region ", region,
             " must be in (0, 3]");
     map.scale[region] = s;
+    ++entries;
   }
+  // An empty map is a mistake (a wrong or truncated file), not "no change".
+  require(entries > 0, path, ": thickness map holds no 'region scale' lines");
   return map;
 }
 

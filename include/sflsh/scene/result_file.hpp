@@ -7,6 +7,10 @@
 // still read. B = number of bodies (1 without /bodies), O = number of objects.
 //   /meta/format_version, /meta/units, /meta/avatar, /meta/motion, /meta/dt,
 //   /meta/bones ("dynamic" | "kinematic"), /meta/newton_iters
+//   /meta/incomplete      int 0 | 1: 1 = the run stopped early (a non-finite value, see
+//                         sim/finite_guard.hpp); the frames are those made before the stop.
+//                         Absent in files written before it existed (= 0).
+//   /meta/stop_reason     string, why the run stopped; only when /meta/incomplete is 1
 //   /surface/faces        (F,3)        skin triangles (every body's, concatenated)
 //   /surface/rest         (V,3)        skin, unposed rest shape
 //   /bodies/names         (B,)         strings; only in files of scenes with bodies named

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sflsh/asset/avatar.hpp"
+#include "sflsh/core/error.hpp"
 #include "sflsh/motion/motion_clip.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/skeleton_terms.hpp"
@@ -35,6 +36,11 @@ struct RunOptions {
   std::string resume;
   /// Save the final state here (a checkpoint to resume from).
   std::string checkpoint;
+  /// TEST ONLY (`sflsh simulate --inject-nan-at-step N`, hidden): the motion
+  /// target of step N (1-based) gets a NaN pelvis bone translation (with kinematic
+  /// bones it becomes the state), to drive the run
+  /// into the numerical guard. 0 = off.
+  long inject_nan_at_step = 0;
 };
 
 /// A rigid object of a scene as results show it (issue 10): its surface in
@@ -88,6 +94,10 @@ struct SimulationResult {
   /// Cholesky solve, summed over all steps (ms), in the step's term order.
   std::vector<std::string> part_names;
   std::vector<double> part_ms;
+  /// The run stopped early (the numerical guard, sim/finite_guard.hpp): the
+  /// frames and steps are those before the stop; `stop_reason` says why.
+  bool incomplete = false;
+  std::string stop_reason;
 
   /// Adds a step's per-term and solve times to part_names/part_ms.
   void add_step_times(const StepReport& report);
@@ -99,10 +109,20 @@ struct SimulationResult {
   std::string describe() const;
 };
 
+/// Thrown by run_simulation when the numerical guard trips: what() names the
+/// step, the term and the body; `partial` holds what was made before the
+/// step (frames already passed to on_frame, steps), marked incomplete.
+class SimulationStopped : public Error {
+ public:
+  SimulationStopped(const std::string& what, SimulationResult partial) : Error(what), partial(std::move(partial)) {}
+  SimulationResult partial;
+};
+
 /// Simulates `avatar` following `motion` from its first frame (state reset to
 /// the motion's first pose, moving with the motion unless
 /// RunOptions::start_at_rest; soft tissue undeformed). Every output frame is passed to
-/// `on_frame` (if given) as it is made. Throws if the state becomes non-finite.
+/// `on_frame` (if given) as it is made. Throws SimulationStopped if the state
+/// or an energy becomes non-finite (no frame of that step is made).
 SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
                                 const std::function<void(const FrameData&)>& on_frame = {});
 
