@@ -21,6 +21,7 @@
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_session.hpp"
+#include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/viewer/live_viewer.hpp"
 
 namespace sflsh::cli {
@@ -144,9 +145,16 @@ void run_scene_live(const RunArgs& a) {
   lo.max_substeps = a.max_substeps;
   lo.progress = !a.quiet_status;
   LiveRunStatus status;
+  std::string stopped;  // the numerical guard's message when the run met NaN/Inf
   {
     const InterruptScope interrupt_scope;
-    status = run_live(session, lo, hooks);
+    try {
+      status = run_live(session, lo, hooks);
+    } catch (const NonFiniteError& e) {
+      stopped = e.what();
+      result.incomplete = true;
+      result.stop_reason = stopped;
+    }
   }
   std::cout << status.describe(a.realtime) << "\n";
   if (view) std::cout << view->summary() << "\n";
@@ -168,8 +176,9 @@ void run_scene_live(const RunArgs& a) {
   if (!a.out.empty()) {
     write_simulation_result(result, a.out);
     std::printf("wrote %s (%d frames%s)\n", a.out.c_str(), result.num_frames,
-                status.interrupted ? ", up to the signal" : "");
+                status.interrupted ? ", up to the signal" : stopped.empty() ? "" : ", marked incomplete");
   }
+  if (!stopped.empty()) fail(stopped);
 }
 
 const CommandRegistrar reg(45, [](CLI::App& app) {

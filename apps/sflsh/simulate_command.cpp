@@ -75,7 +75,12 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   SimulationResult r;
   {
     const InterruptScope interrupt_scope;
-    r = run_scene(scene, o, &stats);
+    try {
+      r = run_scene(scene, o, &stats);
+    } catch (SimulationStopped& e) {
+      write_simulation_result(e.partial, out.out);  // the numerical guard: the frames made, marked incomplete
+      fail(e.what(), "; wrote the ", e.partial.num_frames, " frames before it to ", out.out, " (marked incomplete)");
+    }
     throw_if_interrupted("after the last step");
   }
   write_simulation_result(r, out.out);

@@ -10,6 +10,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/scene/scene_session.hpp"
+#include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/sim/momentum.hpp"
 
 namespace sflsh {
@@ -74,7 +75,16 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
   Progress progress("simulating " + r.motion, steps);
   for (long k = 0; k < steps; ++k) {
     if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
-    const StepReport& rep = session.advance();
+    const StepReport* step_report = nullptr;
+    try {
+      step_report = &session.advance();
+    } catch (const NonFiniteError& e) {
+      // Keep the frames made so far, marked incomplete (no frame of this step).
+      r.incomplete = true;
+      r.stop_reason = e.what();
+      throw SimulationStopped(e.what(), std::move(r));
+    }
+    const StepReport& rep = *step_report;
     const double t = (k + 1) * session.dt();
     for (int i = 0; i < session.num_tools(); ++i) {
       const SceneToolState& ts = session.tool_state(i);

@@ -16,6 +16,7 @@
 #include "sflsh/sim/energies/capsule_contact.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/energies/virtual_coupling.hpp"
+#include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/sim/grasp_controller.hpp"
 #include "sflsh/sim/rigid_body_terms.hpp"
 #include "sflsh/sim/skeleton_terms.hpp"
@@ -528,6 +529,8 @@ const StepReport& SceneSession::advance() {
   m.report = sim.step(in);
   m.k = k + 1;
   const StepReport& rep = m.report;
+  // Stops on NaN/Inf, naming the step, the term and the body (sim/finite_guard.hpp).
+  require_finite_step(sim.model(), sim.scene_state(), rep, k + 1, m.sc.path.empty() ? "scene" : m.sc.path);
   // Tool feedback: the force on each tool is minus what its contact and
   // anchor terms exert on the bodies.
   for (SceneTool& tl : m.tools) {

@@ -60,7 +60,9 @@ struct SceneContactStats {
 /// Simulates `scene` (read and checked by read_scene_description and
 /// validate_scene_files) and returns the result with every output frame.
 /// Throws naming the body/object on inputs the runtime rejects (e.g. an avatar
-/// without capsules in body contact) and when the state becomes non-finite.
+/// without capsules in body contact), and SimulationStopped (with the frames
+/// made so far, marked incomplete) when the state or an energy becomes
+/// non-finite, naming the step, the term and the body.
 SimulationResult run_scene(const SceneDescription& scene, const SceneRunOptions& options = {},
                            SceneContactStats* stats = nullptr);
 
