@@ -1,6 +1,7 @@
 // Replays every fuzz target (fuzz/fuzz_targets.hpp) over
-//  - the findings of scripts/fuzz.sh when SFLSH_FUZZ_REPLAY_DIR points at them
-//    (each must parse or throw sflsh::Error; generated inputs are not committed), and
+//  - the committed findings of scripts/fuzz.sh (tests/fuzz_regressions/<target>/)
+//    and, when SFLSH_FUZZ_REPLAY_DIR points at them, new ones (each must parse
+//    or throw sflsh::Error), and
 //  - valid files made here (and the project's own test files), each also cut
 //    short at several lengths and with bytes overwritten at spread positions:
 //    a small, deterministic mutation pass that runs on every build.
@@ -107,23 +108,26 @@ SimulationResult tiny_result() {
 }  // namespace
 
 TEST(FuzzReplay, RegressionInputsParseOrThrowTheProjectError) {
-  // Findings of scripts/fuzz.sh (build-fuzz/crashes/<target>/): generated
-  // data is not committed, so this replays them only when pointed at them.
-  const char* dir_env = std::getenv("SFLSH_FUZZ_REPLAY_DIR");
-  if (!dir_env) GTEST_SKIP() << "set SFLSH_FUZZ_REPLAY_DIR=build-fuzz/crashes to replay scripts/fuzz.sh findings";
-  const fs::path root = dir_env;
-  int replayed = 0;
-  for (const auto& t : fuzz::all_targets()) {
-    const fs::path dir = root / t.name;
-    if (!fs::is_directory(dir)) continue;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      if (!e.is_regular_file() || e.path().filename() == "README.md") continue;
-      SCOPED_TRACE(e.path().string());
-      run(t, read_bytes(e.path()));
-      ++replayed;
+  // The committed findings (tests/fuzz_regressions/<target>/, every run) and,
+  // when SFLSH_FUZZ_REPLAY_DIR points at them, new ones of scripts/fuzz.sh
+  // (build-fuzz/crashes/<target>/).
+  std::vector<fs::path> roots = {fs::path(test::source_dir()) / "tests" / "fuzz_regressions"};
+  if (const char* dir_env = std::getenv("SFLSH_FUZZ_REPLAY_DIR")) roots.emplace_back(dir_env);
+  int replayed = 0, committed = 0;
+  for (const fs::path& root : roots)
+    for (const auto& t : fuzz::all_targets()) {
+      const fs::path dir = root / t.name;
+      if (!fs::is_directory(dir)) continue;
+      for (const auto& e : fs::directory_iterator(dir)) {
+        if (!e.is_regular_file() || e.path().filename() == "README.md") continue;
+        SCOPED_TRACE(e.path().string());
+        run(t, read_bytes(e.path()));
+        ++replayed;
+        if (root == roots[0]) ++committed;
+      }
     }
-  }
-  std::printf("replayed %d regression inputs\n", replayed);
+  std::printf("replayed %d regression inputs (%d committed)\n", replayed, committed);
+  EXPECT_GT(committed, 0) << "tests/fuzz_regressions/ is missing";
 }
 
 TEST(FuzzReplay, ValidAndMutatedProjectFiles) {
