@@ -203,12 +203,18 @@ def extract(raw, path):
 def write_h5(m, out_path, source):
     import h5py
     tmp = out_path + ".partial"
-    strings = h5py.string_dtype("utf-8")
+    def strings(h, name, values):
+        # Fixed-length byte strings holding UTF-8 (sflsh refuses variable-length
+        # strings: libhdf5 reads them from its global heap without bounds checks).
+        data = [v.encode("utf-8") for v in values]
+        width = max(1, max(len(d) for d in data))
+        h.create_dataset(name, data=np.array(data, dtype="S%d" % width))
+
     try:
         with h5py.File(tmp, "w") as h:
             h.create_dataset("meta/format_version", data=np.array([FORMAT_VERSION], dtype=np.int64))
-            h.create_dataset("meta/units", data=np.array(["metres"], dtype=object), dtype=strings)
-            h.create_dataset("meta/source", data=np.array([source], dtype=object), dtype=strings)
+            strings(h, "meta/units", ["metres"])
+            strings(h, "meta/source", [source])
             for key in ("v_template", "f", "shapedirs", "posedirs", "weights", "kintree_table"):
                 h.create_dataset(key, data=m[key], compression="gzip" if m[key].size >= 4096 else None)
             jr = m["J_regressor"]
@@ -216,7 +222,7 @@ def write_h5(m, out_path, source):
             h.create_dataset("J_regressor_csr/indices", data=jr.indices.astype(np.int32))
             h.create_dataset("J_regressor_csr/data", data=jr.data.astype(np.float64))
             h.create_dataset("J_regressor_csr/shape", data=np.array(jr.shape, dtype=np.int32))
-            h.create_dataset("joint_names", data=np.array(SMPL_JOINT_NAMES, dtype=object), dtype=strings)
+            strings(h, "joint_names", SMPL_JOINT_NAMES)
         os.replace(tmp, out_path)
     finally:
         if os.path.exists(tmp):

@@ -1,24 +1,27 @@
 #!/usr/bin/env bash
 # Fuzz the readers with libFuzzer + AddressSanitizer + UBSan.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default: 60 s each, every target)
-# Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5.
+# Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5 material
+# scene_yaml mesh stream pose_file.
 # Needs clang and compiler-rt (Debian: clang libclang-rt-14-dev; scripts/setup.sh).
 #
 # Builds into build-fuzz/ (the reader sources, instrumented; the rest from the
 # normal build's libraries, which it builds if needed), seeds each corpus with valid files
 # made from the project's own test data (test_fuzz with SFLSH_FUZZ_SEED_DIR,
-# from the normal build) plus earlier findings in build-fuzz/crashes/<target>/, and runs each
+# from the normal build) plus the committed findings in tests/fuzz_regressions/<target>/
+# and earlier ones in build-fuzz/crashes/<target>/, and runs each
 # target for SECONDS with a 10 s per-input timeout, a 2 GB RSS limit and a
 # 256 MB single-allocation limit (a small file must not make a reader
 # allocate more). A crash, leak, timeout or out-of-memory input stays in
-# build-fuzz/crashes/<target>/ (generated data is not committed); replay them with
+# build-fuzz/crashes/<target>/; replay them with
 # SFLSH_FUZZ_REPLAY_DIR=build-fuzz/crashes build/test_fuzz, fix the reader, and
-# turn the case into a test that builds its input. Exit status: non-zero if any target
-# found something. FUZZ_BUILD_ONLY=1 only builds.
+# copy the input to tests/fuzz_regressions/<target>/ (test_fuzz replays those on every
+# run). Leaks inside libhdf5's own error paths are suppressed (fuzz/lsan.supp).
+# Exit status: non-zero if any target found something new. FUZZ_BUILD_ONLY=1 only builds.
 set -euo pipefail
 SECONDS_TO_RUN="${1:-60}"
 [ $# -gt 0 ] && shift
-ALL_TARGETS=(bvh npz body_model_h5 avatar_h5 result_h5)
+ALL_TARGETS=(bvh npz body_model_h5 avatar_h5 result_h5 material scene_yaml mesh stream pose_file)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL_TARGETS[@]}")
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
@@ -35,7 +38,9 @@ read -r -a LIBS <<< "$(pkg-config --libs hdf5 libzip) -lz"
 SOURCES=(fuzz/fuzz_targets.cpp src/core/*.cpp src/io/hdf5_file.cpp src/io/npz.cpp src/io/atomic_output.cpp
          src/asset/avatar_file.cpp src/body/body_model_io.cpp src/body/body_model.cpp src/body/smpl_skeleton.cpp
          src/motion/bvh.cpp src/motion/skeleton_motion.cpp src/motion/retarget.cpp src/motion/motion_clip.cpp
-         src/scene/result_file.cpp)
+         src/scene/result_file.cpp src/scene/material_file.cpp src/scene/scene_description.cpp src/io/mesh_export.cpp
+         src/meshing/mesh_sdf_bake.cpp src/meshing/surface_checks.cpp src/geometry/grid_sdf.cpp
+         src/teleop/stream_message.cpp src/teleop/pose_stream_filter.cpp src/teleop/pose_file.cpp)
 
 echo "building the fuzz targets in $OUT ..."
 OBJS=()
@@ -57,12 +62,13 @@ if [ ! -x "$BUILD/test_fuzz" ]; then
     { tail -20 "$OUT/normal_build.log"; exit 1; }
 fi
 NORMAL_LIBS=()
-for m in scene sim motion asset fem geometry body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
+for m in scene teleop sim motion asset fem meshing geometry body mesh io core; do NORMAL_LIBS+=("$BUILD/libsflsh_$m.a"); done
 for t in "${TARGETS[@]}"; do
   $CXX "${FLAGS[@]}" -fsanitize=fuzzer -DSFLSH_FUZZ_TARGET="$t" "${EIGEN[@]}" fuzz/fuzz_main.cpp "${OBJS[@]}" \
     -Wl,--gc-sections -Wl,--allow-multiple-definition "${NORMAL_LIBS[@]}" "${LIBS[@]}" \
     -lcholmod -lsuitesparseconfig -ltbb -lpng -lassimp -lyaml-cpp -lgmp -lmpfr -o "$OUT/${t}_fuzz"
 done
+if [ -n "${FUZZ_BUILD_ONLY:-}" ]; then echo "built ${TARGETS[*]} in $OUT"; exit 0; fi
 echo "making seed files from the project's test data ..."
 rm -rf "$OUT/seeds"
 SFLSH_FUZZ_SEED_DIR="$OUT/seeds" "${SFLSH_BUILD_DIR:-build}/test_fuzz" \
@@ -75,20 +81,21 @@ run_target() {
   for f in "$OUT/seeds/$t"/*; do
     [ -f "$f" ] && [ "$(stat -c %s "$f")" -gt "$max_len" ] && max_len=$(stat -c %s "$f")
   done
+  local regressions=()
+  [ -d "$ROOT/tests/fuzz_regressions/$t" ] && regressions=("$ROOT/tests/fuzz_regressions/$t")
+  local before
+  before=$(ls "$OUT/crashes/$t" | wc -l)
   local status=0
-  (cd "$OUT" && ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" \
+  (cd "$OUT" && ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" LSAN_OPTIONS="suppressions=$ROOT/fuzz/lsan.supp" \
+     "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" \
      -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
-     -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$OUT/crashes/$t" \
+     -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$OUT/crashes/$t" "${regressions[@]}" \
      > "$log" 2>&1) || status=$?
-  local execs cov
+  local execs cov found
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*')
-  local found=0
-  for a in "$OUT/crashes/$t"/*; do
-    [ -f "$a" ] || continue
-    found=$((found + 1))
-  done
-  echo "$t: ${execs:-?} executions, coverage ${cov:-?} edges, corpus $(ls "$OUT/corpus/$t" | wc -l) inputs, exit $status, $found finding(s) (log: $log)"
+  found=$(( $(ls "$OUT/crashes/$t" | wc -l) - before ))
+  echo "$t: ${execs:-?} executions, coverage ${cov:-?} edges, corpus $(ls "$OUT/corpus/$t" | wc -l) inputs, exit $status, $found new finding(s) (log: $log)"
   [ "$status" -eq 0 ] && [ "$found" -eq 0 ]
 }
 

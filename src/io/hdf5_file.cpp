@@ -2,8 +2,10 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -168,6 +170,24 @@ void Hdf5File::check_declared_size(const std::string& name, std::uint64_t count,
          "-byte file can hold (corrupted file?)");
 }
 
+void Hdf5File::check_number_type(long type, const std::string& name) const {
+  // Only the usual layouts: libhdf5 1.10 converts exotic ones (e.g. a
+  // 32-byte float, found by scripts/fuzz.sh) past the end of its buffers.
+  const auto cls = H5Tget_class(type);
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER) fail(path_, ": dataset ", name, " is not numeric");
+  bool usual = false;
+  if (cls == H5T_FLOAT) {
+    for (hid_t t : {H5T_IEEE_F32LE, H5T_IEEE_F32BE, H5T_IEEE_F64LE, H5T_IEEE_F64BE}) usual = usual || H5Tequal(type, t) > 0;
+  } else {
+    const size_t size = H5Tget_size(type);
+    usual = (size == 1 || size == 2 || size == 4 || size == 8) && H5Tget_precision(type) == 8 * size &&
+            H5Tget_offset(type) == 0;
+  }
+  if (!usual)
+    fail(path_, ": dataset ", name, " has an unsupported number type (", H5Tget_size(type),
+         " bytes); expected IEEE float32/float64 or an 8/16/32/64-bit integer");
+}
+
 long Hdf5File::open_dataset(const std::string& name) const {
   if (!has(name)) fail(path_, ": dataset ", name, " is missing");
   hid_t ds = H5Dopen2(file_, name.c_str(), H5P_DEFAULT);
@@ -303,17 +323,25 @@ void Hdf5File::write_scalar(const std::string& name, std::int64_t value) {
 void Hdf5File::write_strings(const std::string& name, const std::vector<std::string>& values) {
   require(mode_ == Mode::Write, path_, ": write on a file opened for reading");
   ensure_parent_groups(name);
+  // Fixed-length strings (no global heap; see read_strings), as wide as the
+  // longest value, padded with NULs.
+  size_t width = 1;
+  for (const auto& v : values) {
+    require(v.find('\0') == std::string::npos, path_, ": dataset ", name, ": a string holds a NUL byte");
+    width = std::max(width, v.size());
+  }
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(type.id, H5T_VARIABLE);
+  H5Tset_size(type.id, width);
+  H5Tset_strpad(type.id, H5T_STR_NULLPAD);
   H5Tset_cset(type.id, H5T_CSET_UTF8);
-  std::vector<const char*> ptrs;
-  for (auto& v : values) ptrs.push_back(v.c_str());
+  std::vector<char> buf(width * values.size(), '\0');
+  for (size_t i = 0; i < values.size(); ++i) std::copy(values[i].begin(), values[i].end(), buf.begin() + i * width);
   hsize_t n = values.size();
   Handle sp(H5Screate_simple(1, &n, nullptr), H5Sclose);
   Handle dcpl(untimed(H5P_DATASET_CREATE), H5Pclose);
   Handle ds(H5Dcreate2(file_, name.c_str(), type.id, sp.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT), H5Dclose);
   if (ds.id < 0) fail(path_, ": cannot create dataset ", name);
-  if (n > 0 && H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) < 0)
+  if (n > 0 && H5Dwrite(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
     fail(path_, ": cannot write dataset ", name);
 }
 
@@ -328,28 +356,28 @@ std::vector<std::string> Hdf5File::read_strings(const std::string& name) const {
   Handle sp(H5Dget_space(ds.id), H5Sclose);
   const hssize_t n = H5Sget_simple_extent_npoints(sp.id);
   if (n < 0) fail(path_, ": dataset ", name, " has an unreadable shape");
+  // Variable-length strings live in HDF5's global heap, which libhdf5 1.10
+  // reads without bounds checks: a damaged file hangs or overruns it
+  // (H5HG_read, found by scripts/fuzz.sh). sflsh writes fixed-length strings
+  // and refuses the others before touching the heap.
+  if (H5Tis_variable_str(ftype.id) != 0)
+    fail(path_, ": dataset ", name,
+         " holds variable-length strings, which this sflsh does not read (written by an older sflsh or another "
+         "tool): run again the sflsh command that made the file (e.g. `sflsh precompute` for an avatar), or store "
+         "the strings as fixed-length (h5py: dtype 'S<n>')");
+  const size_t sz = H5Tget_size(ftype.id);
+  if (sz == 0) fail(path_, ": dataset ", name, " has strings of size 0");
+  check_declared_size(name, std::uint64_t(n), sz + sizeof(std::string));
+  std::vector<char> buf(sz * n + 1, 0);
+  if (n > 0 && H5Dread(ds.id, ftype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
+    fail(path_, ": cannot read dataset ", name);
+  const bool space_padded = H5Tget_strpad(ftype.id) == H5T_STR_SPACEPAD;
   std::vector<std::string> out;
-  if (H5Tis_variable_str(ftype.id) > 0) {
-    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(mtype.id, H5T_VARIABLE);
-    H5Tset_cset(mtype.id, H5Tget_cset(ftype.id));  // HDF5 does not convert ASCII <-> UTF-8
-    check_declared_size(name, std::uint64_t(n), sizeof(char*) + sizeof(std::string));
-    std::vector<char*> buf(n, nullptr);
-    if (n > 0 && H5Dread(ds.id, mtype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
-      fail(path_, ": cannot read dataset ", name);
-    for (auto* p : buf) out.emplace_back(p ? p : "");
-    if (n > 0) H5Dvlen_reclaim(mtype.id, sp.id, H5P_DEFAULT, buf.data());
-  } else {
-    const size_t sz = H5Tget_size(ftype.id);
-    if (sz == 0) fail(path_, ": dataset ", name, " has strings of size 0");
-    check_declared_size(name, std::uint64_t(n), sz + sizeof(std::string));
-    std::vector<char> buf(sz * n + 1, 0);
-    if (n > 0 && H5Dread(ds.id, ftype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
-      fail(path_, ": cannot read dataset ", name);
-    for (hssize_t i = 0; i < n; ++i) {
-      std::string s(buf.data() + i * sz, sz);
-      out.emplace_back(s.c_str());
-    }
+  for (hssize_t i = 0; i < n; ++i) {
+    std::string s(buf.data() + i * sz, sz);
+    s.resize(std::strlen(s.c_str()));
+    if (space_padded) s.erase(s.find_last_not_of(' ') + 1);
+    out.push_back(std::move(s));
   }
   return out;
 }
@@ -364,8 +392,7 @@ std::vector<double> Hdf5File::read_nd(const std::string& name, const std::vector
                                       std::vector<std::int64_t>* shape_out) const {
   Handle ds(open_dataset(name), H5Dclose);
   Handle ftype(H5Dget_type(ds.id), H5Tclose);
-  auto cls = H5Tget_class(ftype.id);
-  if (cls != H5T_FLOAT && cls != H5T_INTEGER) fail(path_, ": dataset ", name, " is not numeric");
+  check_number_type(ftype.id, name);
   auto s = shape(name);
   bool ok = expected.empty() || s.size() == expected.size();
   for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] < 0 || expected[i] == s[i];

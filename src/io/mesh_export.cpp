@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <random>
+#include <string_view>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
@@ -244,13 +245,15 @@ void write_mesh(const std::string& path, const Points& V, const Triangles& F, co
   out.commit();
 }
 
-ImportedMesh read_mesh(const std::string& path) {
-  require(fs::exists(path), path, ": no such file");
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_JoinIdenticalVertices | aiProcess_Triangulate | aiProcess_PreTransformVertices);
-  if (!scene) fail(path, ": cannot read mesh: ", importer.GetErrorString());
+namespace {
 
+// ValidateDataStructure first: the other steps index out of bounds on a damaged
+// file (a face index past the vertex count; found by scripts/fuzz.sh).
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices | aiProcess_Triangulate |
+                                  aiProcess_PreTransformVertices;
+
+// The triangles of every mesh of `scene` (`path` names the file in errors).
+ImportedMesh imported_triangles(const aiScene* scene, const std::string& path) {
   ImportedMesh out;
   size_t nv = 0, nf = 0;
   bool any_colors = false;
@@ -277,6 +280,9 @@ ImportedMesh read_mesh(const std::string& path) {
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      for (int k = 0; k < 3; ++k)
+        require(face.mIndices[k] < mesh->mNumVertices, path, ": a triangle refers to vertex ", face.mIndices[k],
+                " of a mesh with ", mesh->mNumVertices, " vertices");
       out.faces.row(fi++) << int(vbase + face.mIndices[0]), int(vbase + face.mIndices[1]),
           int(vbase + face.mIndices[2]);
     }
@@ -284,6 +290,43 @@ ImportedMesh read_mesh(const std::string& path) {
   }
   require(out.vertices.allFinite(), path, ": vertex positions contain NaN or Inf");
   return out;
+}
+
+// assimp 5.2 loops forever on a PLY file whose header has no end_header line
+// (e.g. a truncated file; found by scripts/fuzz.sh): check that first. `head`
+// is the start of the file (its first kPlyHeaderLimit bytes or all of it).
+constexpr std::size_t kPlyHeaderLimit = 1 << 20;
+void check_ply_header(std::string_view head, const std::string& path) {
+  if (head.substr(0, 3) != "ply") return;
+  require(head.find("end_header") != std::string_view::npos, path, ": PLY header without an end_header line in its first ",
+          std::min(head.size(), kPlyHeaderLimit), " bytes (truncated file?)");
+}
+
+}  // namespace
+
+ImportedMesh read_mesh(const std::string& path) {
+  require(fs::exists(path), path, ": no such file");
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(kPlyHeaderLimit, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(std::size_t(in.gcount()));
+    check_ply_header(head, path);
+  }
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path, kImportSteps);
+  if (!scene) fail(path, ": cannot read mesh: ", importer.GetErrorString());
+  return imported_triangles(scene, path);
+}
+
+ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std::string& format,
+                                   const std::string& name) {
+  require(size > 0, name, ": empty mesh file");
+  check_ply_header(std::string_view(static_cast<const char*>(data), std::min(size, kPlyHeaderLimit)), name);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
+  if (!scene) fail(name, ": cannot read mesh: ", importer.GetErrorString());
+  return imported_triangles(scene, name);
 }
 
 }  // namespace sflsh::io

@@ -3,8 +3,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/input_file.hpp"
@@ -16,10 +18,16 @@ std::string where(const std::string& path, const YAML::Node& n) {
   return path + ":" + std::to_string(n.Mark().line + 1);
 }
 
+// A map key as text; a key that is itself a list or map is an error.
+std::string scalar_key(const std::string& path, const YAML::Node& key) {
+  if (!key.IsScalar()) fail(where(path, key), ": expected a plain name as key, got a list or map");
+  return key.Scalar();
+}
+
 void apply(const std::string& path, const YAML::Node& params, RegionMaterial& m) {
   if (!params.IsMap()) fail(where(path, params), ": expected a map of material parameters for region '", m.name, "'");
   for (const auto& kv : params) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = scalar_key(path, kv.first);
     double v;
     try {
       v = kv.second.as<double>();
@@ -51,23 +59,18 @@ void apply(const std::string& path, const YAML::Node& params, RegionMaterial& m)
 
 }  // namespace
 
-void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials) {
-  io::require_input_file(path, "material file");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    fail(path, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
-  }
+namespace {
+
+void apply_root(const std::string& path, const YAML::Node& root, std::vector<RegionMaterial>& materials) {
   if (!root.IsMap()) fail(path, ": expected a map with 'all' and/or 'regions'");
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = scalar_key(path, kv.first);
     if (key == "all") {
       for (auto& m : materials) apply(path, kv.second, m);
     } else if (key == "regions") {
       if (!kv.second.IsMap()) fail(where(path, kv.second), ": 'regions' must map region names to parameters");
       for (const auto& r : kv.second) {
-        const std::string name = r.first.as<std::string>();
+        const std::string name = scalar_key(path, r.first);
         auto it = std::find_if(materials.begin(), materials.end(), [&](const RegionMaterial& m) { return m.name == name; });
         if (it == materials.end()) {
           std::string known;
@@ -80,6 +83,29 @@ void apply_material_file(const std::string& path, std::vector<RegionMaterial>& m
       fail(where(path, kv.first), ": unknown top-level key '", key, "' (expected 'all' or 'regions')");
     }
   }
+}
+
+YAML::Node load_yaml(const std::string& name, const std::string& text) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    fail(name, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
+  }
+}
+
+}  // namespace
+
+void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials) {
+  io::require_input_file(path, "material file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) fail(path, ": cannot read the material file");
+  apply_material_text(text.str(), path, materials);
+}
+
+void apply_material_text(const std::string& text, const std::string& name, std::vector<RegionMaterial>& materials) {
+  apply_root(name, load_yaml(name, text), materials);
 }
 
 void write_material_file(const std::string& path, const std::vector<RegionMaterial>& materials,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <limits>
 #include <set>
 
@@ -68,7 +69,8 @@ class SceneParser {
                  const std::string& what) const {
     if (!n.IsMap()) error(n, key, "expected a map (", what, ")");
     for (const auto& kv : n) {
-      const std::string k = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) error(kv.first, key, "expected a plain name as key, got a list or map");
+      const std::string k = kv.first.Scalar();
       if (std::find(allowed.begin(), allowed.end(), k) == allowed.end())
         error(kv.first, child_key(key, k), "unknown key '", k, "' for ", what, " (expected: ", join(allowed), ")");
     }
@@ -536,9 +538,17 @@ bool SceneDescription::collides(const std::string& a, const std::string& b) cons
 
 SceneDescription read_scene_description(const std::string& path) {
   if (!fs::is_regular_file(path)) fail(path, ": scene file not found");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) fail(path, ": cannot read the scene file");
+  return parse_scene_description(text.str(), path);
+}
+
+SceneDescription parse_scene_description(const std::string& yaml_text, const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& e) {
     fail(path, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
   }

@@ -1,6 +1,7 @@
 // Replays every fuzz target (fuzz/fuzz_targets.hpp) over
-//  - the findings of scripts/fuzz.sh when SFLSH_FUZZ_REPLAY_DIR points at them
-//    (each must parse or throw sflsh::Error; generated inputs are not committed), and
+//  - the committed findings of scripts/fuzz.sh (tests/fuzz_regressions/<target>/)
+//    and, when SFLSH_FUZZ_REPLAY_DIR points at them, new ones (each must parse
+//    or throw sflsh::Error), and
 //  - valid files made here (and the project's own test files), each also cut
 //    short at several lengths and with bytes overwritten at spread positions:
 //    a small, deterministic mutation pass that runs on every build.
@@ -19,8 +20,12 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/io/npz.hpp"
+#include "sflsh/geometry/primitive_meshes.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/mesh_export.hpp"
 #include "sflsh/scene/result_file.hpp"
+#include "sflsh/teleop/pose_file.hpp"
+#include "sflsh/teleop/stream_message.hpp"
 #include "sim/synthetic_avatar.hpp"
 #include "test_support.hpp"
 
@@ -107,23 +112,26 @@ SimulationResult tiny_result() {
 }  // namespace
 
 TEST(FuzzReplay, RegressionInputsParseOrThrowTheProjectError) {
-  // Findings of scripts/fuzz.sh (build-fuzz/crashes/<target>/): generated
-  // data is not committed, so this replays them only when pointed at them.
-  const char* dir_env = std::getenv("SFLSH_FUZZ_REPLAY_DIR");
-  if (!dir_env) GTEST_SKIP() << "set SFLSH_FUZZ_REPLAY_DIR=build-fuzz/crashes to replay scripts/fuzz.sh findings";
-  const fs::path root = dir_env;
-  int replayed = 0;
-  for (const auto& t : fuzz::all_targets()) {
-    const fs::path dir = root / t.name;
-    if (!fs::is_directory(dir)) continue;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      if (!e.is_regular_file() || e.path().filename() == "README.md") continue;
-      SCOPED_TRACE(e.path().string());
-      run(t, read_bytes(e.path()));
-      ++replayed;
+  // The committed findings (tests/fuzz_regressions/<target>/, every run) and,
+  // when SFLSH_FUZZ_REPLAY_DIR points at them, new ones of scripts/fuzz.sh
+  // (build-fuzz/crashes/<target>/).
+  std::vector<fs::path> roots = {fs::path(test::source_dir()) / "tests" / "fuzz_regressions"};
+  if (const char* dir_env = std::getenv("SFLSH_FUZZ_REPLAY_DIR")) roots.emplace_back(dir_env);
+  int replayed = 0, committed = 0;
+  for (const fs::path& root : roots)
+    for (const auto& t : fuzz::all_targets()) {
+      const fs::path dir = root / t.name;
+      if (!fs::is_directory(dir)) continue;
+      for (const auto& e : fs::directory_iterator(dir)) {
+        if (!e.is_regular_file() || e.path().filename() == "README.md") continue;
+        SCOPED_TRACE(e.path().string());
+        run(t, read_bytes(e.path()));
+        ++replayed;
+        if (root == roots[0]) ++committed;
+      }
     }
-  }
-  std::printf("replayed %d regression inputs\n", replayed);
+  std::printf("replayed %d regression inputs (%d committed)\n", replayed, committed);
+  EXPECT_GT(committed, 0) << "tests/fuzz_regressions/ is missing";
 }
 
 TEST(FuzzReplay, ValidAndMutatedProjectFiles) {
@@ -149,6 +157,54 @@ TEST(FuzzReplay, ValidAndMutatedProjectFiles) {
   check_valid_file("avatar_h5", "synthetic_avatar.h5", read_bytes(tmp.file("avatar.h5")));
   write_simulation_result(tiny_result(), tmp.file("result.h5"));
   check_valid_file("result_h5", "tiny_result.h5", read_bytes(tmp.file("result.h5")));
+  // Material files.
+  check_valid_file("material", "all_and_regions.yaml",
+                   "all:\n  young: 2.0e4\n  poisson: 0.45\nregions:\n  belly: {young_along: 1.0e4, young_through: 5.0e3, "
+                   "young_around: 8.0e3, fung_c: 1.0e3}\n  thigh: {young: 3.0e4, density: 1050}\n");
+  check_valid_file("material", "flow.yaml", "{regions: {chest: {poisson: 0.3}, upper_arm: {density: 990}}}\n");
+  // Scenes: the shipped ones (they name avatar.h5 and pinch.csv, present in the target's folder).
+  const fs::path scenes = fs::path(test::source_dir()) / "apps" / "scenes";
+  for (const fs::path dir : {scenes, scenes / "figures"})
+    for (const auto& e : fs::directory_iterator(dir))
+      if (e.path().extension() == ".yaml") check_valid_file("scene_yaml", e.path().filename().string(), read_bytes(e.path()));
+  // Meshes: a box as OBJ and PLY (io::write_mesh) and as ASCII STL; byte 0 picks the format.
+  const geometry::PrimitiveMesh box = geometry::box_mesh(Vec3(0.05, 0.02, 0.03), 2);
+  io::write_mesh(tmp.file("box.obj"), box.vertices, box.faces);
+  io::write_mesh(tmp.file("box.ply"), box.vertices, box.faces);
+  check_valid_file("mesh", "box.obj", std::string(1, '\0') + read_bytes(tmp.file("box.obj")));
+  check_valid_file("mesh", "box.ply", std::string(1, '\2') + read_bytes(tmp.file("box.ply")));
+  std::ostringstream stl;
+  stl << "solid box\n";
+  for (Eigen::Index f = 0; f < box.faces.rows(); ++f) {
+    stl << " facet normal 0 0 0\n  outer loop\n";
+    for (int k = 0; k < 3; ++k) stl << "   vertex " << box.vertices.row(box.faces(f, k)) << "\n";
+    stl << "  endloop\n endfacet\n";
+  }
+  stl << "endsolid box\n";
+  check_valid_file("mesh", "box.stl", std::string(1, '\1') + stl.str());
+  // Pose stream: three poses and a feedback message, each after its length byte.
+  std::string datagrams;
+  for (int k = 0; k < 3; ++k) {
+    teleop::PoseMessage m;
+    m.sequence = std::uint64_t(k + 1);
+    m.sample.time = 0.01 * k;
+    m.sample.position = Vec3(0.1, 1.0 + 0.001 * k, 0.1);
+    m.sample.closure = 0.5;
+    const auto bytes = teleop::encode_pose(m);
+    datagrams += char(bytes.size());
+    datagrams.append(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  }
+  const auto feedback = teleop::encode_feedback(teleop::FeedbackMessage{3, 0.02, Vec3(1, 2, 3), Vec3(0, 0, 1)});
+  datagrams += char(feedback.size());
+  datagrams.append(reinterpret_cast<const char*>(feedback.data()), feedback.size());
+  check_valid_file("stream", "three_poses_and_feedback.bin", datagrams);
+  // Pose files: the shipped CSV and the same samples as JSON lines.
+  const fs::path pinch = scenes / "figures" / "pinch.csv";
+  check_valid_file("pose_file", "pinch.csv", read_bytes(pinch));
+  std::string jsonl = "# pinch.csv as JSON lines\n";
+  for (const auto& sample : teleop::read_pose_file(pinch.string()))
+    jsonl += teleop::format_pose_row(sample, teleop::PoseFileFormat::kJsonLines) + "\n";
+  check_valid_file("pose_file", "pinch.jsonl", jsonl);
 }
 
 TEST(FuzzReplay, AHugeDeclaredDatasetInATinyFileIsRejectedBeforeAllocating) {

@@ -111,6 +111,29 @@ TEST(MeshExport, PlyBinaryRoundTripWithColors) {
     EXPECT_LT((m.colors.row(i) - C.row(map[size_t(i)])).cwiseAbs().maxCoeff(), 1.0 / 255 + 1e-6);
 }
 
+TEST(MeshExport, ReadingFromMemoryMatchesTheFileAndATruncatedPlyHeaderIsAnError) {
+  // assimp 5.2 loops forever on a PLY header without end_header (found by
+  // scripts/fuzz.sh on a truncated file): both readers refuse it first.
+  test::TempDir dir;
+  Points V;
+  Triangles F;
+  octahedron(V, F);
+  write_mesh(dir.file("o.ply"), V, F);
+  std::ifstream is(dir.file("o.ply"), std::ios::binary);
+  std::ostringstream ss;
+  ss << is.rdbuf();
+  const std::string bytes = ss.str();
+  const ImportedMesh m = read_mesh_from_memory(bytes.data(), bytes.size(), "ply", "memory.ply");
+  expect_same_surface(V, F, m, 1e-6);
+  const std::size_t cut = bytes.find("end_header") - 3;  // inside the header
+  const std::string truncated = bytes.substr(0, cut);
+  test::expect_error([&] { read_mesh_from_memory(truncated.data(), truncated.size(), "ply", "cut.ply"); },
+                     {"cut.ply", "end_header", "truncated"});
+  std::ofstream(dir.file("cut.ply"), std::ios::binary) << truncated;
+  test::expect_error([&] { read_mesh(dir.file("cut.ply")); }, {"cut.ply", "end_header"});
+  test::expect_error([&] { read_mesh_from_memory(bytes.data(), 0, "ply", "empty.ply"); }, {"empty.ply", "empty"});
+}
+
 TEST(MeshExport, GlbAndGltfReimportWithSameCounts) {
   test::TempDir dir;
   Points V;

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "sflsh/io/mesh_export.hpp"
+#include "sflsh/scene/material_file.hpp"
 #include "test_support.hpp"
 
 namespace sflsh {
@@ -185,6 +186,28 @@ objects:
     velocity: [0, 0, 1]
 )",
                      {"scene.yaml:8:", "objects[0].velocity", "static object"});
+}
+
+TEST(SceneDescription, ListOrMapKeysAreErrorsAndTextParsesLikeTheFile) {
+  // A flow list as a key made yaml-cpp's as<std::string>() throw its own exception.
+  expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\n? [1, 2]\n: 3\n",
+                     {"scene.yaml:4:", "expected a plain name as key"});
+  // parse_scene_description: the same scene from memory, relative paths against the given path's folder.
+  SceneFolder folder;
+  const std::string text = "bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1}\n";
+  const SceneDescription from_file = read_scene_description(folder.write("scene.yaml", text));
+  const SceneDescription from_text = parse_scene_description(text, folder.file("in-memory.yaml"));
+  EXPECT_EQ(from_text.bodies.at(0).avatar, from_file.bodies.at(0).avatar);
+  EXPECT_EQ(from_text.solver.seconds, 1.0);
+  test::expect_error([&] { parse_scene_description("bodies: [", folder.file("in-memory.yaml")); },
+                     {"in-memory.yaml:1:", "malformed YAML"});
+  // Material text: the same rule for keys.
+  std::vector<RegionMaterial> materials(1);
+  materials[0].name = "belly";
+  test::expect_error([&] { apply_material_text("regions:\n  ? {a: 1}\n  : {young: 1}\n", "m.yaml", materials); },
+                     {"m.yaml:2:", "expected a plain name as key"});
+  apply_material_text("regions: {belly: {young: 2.5e4}}\n", "m.yaml", materials);
+  EXPECT_EQ(materials[0].young_through, 2.5e4);
 }
 
 TEST(SceneDescription, MissingRequiredKeys) {

@@ -68,8 +68,10 @@ class Hdf5File {
   void write_nd(const std::string& name, const double* data, const std::vector<std::int64_t>& shape,
                 bool as_float32 = false);
   void write_nd(const std::string& name, const int* data, const std::vector<std::int64_t>& shape);
+  /// 1-D dataset of fixed-length UTF-8 strings (as wide as the longest value,
+  /// NUL-padded; a value must not contain NUL). Never variable-length: see read_strings.
   void write_strings(const std::string& name, const std::vector<std::string>& values);
-  void write_string(const std::string& name, const std::string& value);  // scalar string dataset
+  void write_string(const std::string& name, const std::string& value);  // a one-element string dataset
   void write_scalar(const std::string& name, double value);
   void write_scalar(const std::string& name, std::int64_t value);
 
@@ -104,6 +106,11 @@ class Hdf5File {
   /// N-D doubles; `expected` entries of -1 are free. Fills `shape_out`.
   std::vector<double> read_nd(const std::string& name, const std::vector<std::int64_t>& expected,
                               std::vector<std::int64_t>* shape_out = nullptr) const;
+  /// A dataset of fixed-length strings (NUL- or space-padding removed).
+  /// Variable-length strings (sflsh before 2026-11-26, h5py's default `str`)
+  /// are refused with an error naming the dataset: libhdf5 1.10 reads them from
+  /// the global heap without bounds checks, so a damaged file could hang or
+  /// crash the reader.
   std::vector<std::string> read_strings(const std::string& name) const;
   std::string read_string(const std::string& name) const;
   double read_scalar(const std::string& name) const;
@@ -115,6 +122,8 @@ class Hdf5File {
 
  private:
   long open_dataset(const std::string& name) const;  // hid_t
+  // Throws unless the file type `type` (hid_t) is IEEE float32/64 or a plain integer.
+  void check_number_type(long type, const std::string& name) const;
   // Throws unless `count` values of `bytes_each` bytes fit the guard above.
   void check_declared_size(const std::string& name, std::uint64_t count, std::uint64_t bytes_each) const;
   std::uint64_t file_bytes_ = 0;  // size of the file or image being read

@@ -9,6 +9,7 @@
 //          with smooth vertex normals and COLOR_0 when colours are given.
 // Units are whatever V is in (sflsh: metres, Y up). Writes are atomic: nothing
 // is left at the target path when writing fails.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -42,5 +43,10 @@ struct ImportedMesh {
 /// assimp's, not necessarily the file's. Throws naming the path on failure or
 /// when the file holds no triangles.
 ImportedMesh read_mesh(const std::string& path);
+/// The same for a file's `size` bytes in memory; `format` is assimp's hint,
+/// the file extension without dot ("obj", "stl", "ply"), and `name` stands for
+/// the file in errors.
+ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std::string& format,
+                                   const std::string& name);
 
 }  // namespace sflsh::io

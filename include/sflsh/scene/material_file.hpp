@@ -20,6 +20,8 @@ namespace sflsh {
 
 /// Applies the overrides in `path` to `materials` (by region name).
 void apply_material_file(const std::string& path, std::vector<RegionMaterial>& materials);
+/// The same for YAML `text` in memory; `name` stands for the file in errors.
+void apply_material_text(const std::string& text, const std::string& name, std::vector<RegionMaterial>& materials);
 
 /// Writes every region of `materials` under `regions:` with all its keys
 /// (young_along, young_through, young_around, poisson, fung_c, density; 17

@@ -292,6 +292,9 @@ struct SceneDescription {
 /// absolute, output paths are kept as written. Throws one sflsh::Error
 /// "FILE:LINE: KEY.PATH: message" on any bad input listed above.
 SceneDescription read_scene_description(const std::string& path);
+/// The same for YAML text in memory: `path` names the file in errors and its
+/// folder resolves relative input paths (the file itself need not exist).
+SceneDescription parse_scene_description(const std::string& yaml_text, const std::string& path);
 
 /// The scene as YAML text in the format above (the keys of each object's
 /// kind, numbers as the shortest decimals that read back to the same values,
