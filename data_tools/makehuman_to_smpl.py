@@ -74,7 +74,10 @@ JOINT_MAP = {
     "spine2": ["spine02____head"],          # lower thoracic
     "ankle": ["foot.{s}____head"],
     "spine3": ["spine01____head"],          # upper thoracic (chest)
-    "foot": ["foot.{s}____tail"],           # ball of the foot (toe bases)
+    # ball of the foot: the five toe bases (metatarsophalangeal joints); foot.L's tail is only the
+    # midpoint of the ankle and joint-l-foot-1
+    "foot": ["toe1-1.{s}____head", "toe2-1.{s}____head", "toe3-1.{s}____head", "toe4-1.{s}____head",
+             "toe5-1.{s}____head"],
     "neck": ["neck01____head"],             # base of the neck
     "collar": ["clavicle.{s}____head"],     # sternal end of the clavicle
     "head": ["head____head"],               # top of the neck (skull base)
