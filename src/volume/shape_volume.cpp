@@ -8,6 +8,7 @@
 #include "sflsh/core/timer.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/point_embedding.hpp"
+#include "sflsh/volume/surface_query.hpp"
 
 namespace sflsh {
 
@@ -17,6 +18,15 @@ std::string ShapeReport::describe() const {
      << " skin vertices outside the tet mesh, farthest " << max_embedding_distance * 1e3 << " mm; shape stage "
      << seconds << " s";
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
+  if (smoothing.passes > 0)
+    os << "\n  interior optimization: min dihedral " << smoothing.min_dihedral_before << " -> "
+       << smoothing.min_dihedral_after << " deg, tets below " << smoothing.below_target_before << " -> "
+       << smoothing.below_target_after << " (target), " << smoothing.nodes_moved << " nodes moved (max "
+       << smoothing.max_displacement * 1e3 << " mm) in " << smoothing.passes << " passes";
+  if (skin_smoothing.passes > 0)
+    os << "; with skin nodes sliding on the skin: min dihedral " << skin_smoothing.min_dihedral_after << " deg, "
+       << skin_smoothing.below_target_after << " tets below target, " << skin_smoothing.nodes_moved
+       << " nodes moved (max " << skin_smoothing.max_displacement * 1e3 << " mm)";
   return os.str();
 }
 
@@ -173,6 +183,43 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       if (mark[n]) relax[n] = last ? 0.0 : 0.5 * relax[n];
   }
   for (int n = 0; n < N; ++n) out.report.num_relaxed_nodes += relax[n] < 1.0;
+
+  // Interior optimization: the thickness map (and a shape that stretches the
+  // layer unevenly) flattens some tets of the thin shell, where nearly every
+  // tet joins skin nodes to bone-surface nodes; the skin stays, the
+  // bone-surface nodes slide across their paths (their depth along the path
+  // is kept to first order), interior nodes move freely.
+  if (o.smoothing.passes > 0) {
+    std::vector<NodeFreedom> freedom(N, NodeFreedom::Free);
+    Points normals = Points::Zero(N, 3);
+    for (int i = 0; i < tv.inner_nodes.size(); ++i) {
+      const int n = tv.inner_nodes[i];
+      const Vec3 path = gb.row(n) - sb.row(n);
+      if (path.norm() > 1e-9) {
+        freedom[n] = NodeFreedom::Slide;
+        normals.row(n) = path.normalized().transpose();
+      } else {
+        freedom[n] = NodeFreedom::Fixed;
+      }
+    }
+    std::vector<char> on_skin(N, 0);
+    for (int i = 0; i < tv.outer_nodes.size(); ++i) on_skin[tv.outer_nodes[i]] = 1;
+    for (int n = 0; n < N; ++n)
+      if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
+    out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
+    if (o.skin_slide_fraction > 0 && tet_quality_report(av.tet).num_below_threshold > 0) {
+      // Skin nodes of the tets still below 8 deg slide along the shaped skin.
+      const SurfaceQuery skin(v_shaped, F);
+      for (int t = 0; t < tv.tet.num_elements(); ++t)
+        if (tet_quality(av.tet, t).min_dihedral_deg < 8.0)
+          for (int i = 0; i < 4; ++i)
+            if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
+      InteriorSmoothingOptions so = o.smoothing;
+      so.max_displacement_fraction = o.skin_slide_fraction;
+      out.report.skin_smoothing = smooth_interior_nodes(av.tet, freedom, normals, so,
+                                                        [&](const Vec3& y) { return skin.closest_point(y); });
+    }
+  }
   out.report.quality = tet_quality_report(av.tet);
   require(out.report.quality.num_inverted == 0, "shape_volume: ", out.report.quality.num_inverted,
           " tets inverted for this shape (smallest volume ", out.report.quality.min_volume,
