@@ -189,7 +189,10 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   // tet joins skin nodes to bone-surface nodes; the skin stays, the
   // bone-surface nodes slide across their paths (their depth along the path
   // is kept to first order), interior nodes move freely.
-  if (o.smoothing.passes > 0) {
+  // The floor: quality_floor_deg, or the template's own minimum if that is lower (a shape
+  // is not asked to make the mesh better than the template).
+  const double quality_floor = std::min(o.quality_floor_deg, tet_quality_report(tv.tet).min_dihedral_deg);
+  if (o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
     std::vector<NodeFreedom> freedom(N, NodeFreedom::Free);
     Points normals = Points::Zero(N, 3);
     for (int i = 0; i < tv.inner_nodes.size(); ++i) {
@@ -207,11 +210,11 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     for (int n = 0; n < N; ++n)
       if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
     out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
-    if (o.skin_slide_fraction > 0 && tet_quality_report(av.tet).num_below_threshold > 0) {
-      // Skin nodes of the tets still below 8 deg slide along the shaped skin.
+    if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor) {
+      // Skin nodes of the tets still below the floor slide along the shaped skin.
       const SurfaceQuery skin(v_shaped, F);
       for (int t = 0; t < tv.tet.num_elements(); ++t)
-        if (tet_quality(av.tet, t).min_dihedral_deg < 8.0)
+        if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
           for (int i = 0; i < 4; ++i)
             if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
       InteriorSmoothingOptions so = o.smoothing;

@@ -29,12 +29,17 @@ struct ShapeOptions {
   /// (a floor, not a target: changing the layer thickness alters every
   /// tet's angles a little).
   double min_dihedral_deg = 2.0;
+  /// The shaped mesh is optimized (below) only if some tet's smallest
+  /// dihedral angle is below this (deg) and below the template mesh's
+  /// smallest; otherwise the nodes stay exactly where the shape and thickness
+  /// map put them.
+  double quality_floor_deg = 8.0;
   /// Optimization of the placed mesh (after the thickness map): interior
   /// nodes move freely, bone-surface nodes slide across their paths (in the
   /// plane orthogonal to skeleton point -> skin point), skin nodes stay, until
   /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it.
   InteriorSmoothingOptions smoothing;
-  /// If tets stay below 8 deg after that (tets with all four nodes on the
+  /// If tets stay below quality_floor_deg after that (tets with all four nodes on the
   /// skin, where the shape flattened the skin), a second round also lets the
   /// skin nodes of the remaining bad tets slide along the shaped skin (each
   /// candidate projected onto it, so they stay exactly on the skin), at most
