@@ -47,9 +47,11 @@ import argparse
 import json
 import os
 import sys
-import tempfile
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import smpl_pkl_to_h5  # noqa: E402  (the HDF5 writer shared with the SMPL converter)
 
 FORMAT_VERSION = 1
 NUM_JOINTS = 24
@@ -550,8 +552,8 @@ def convert(folder, out_path, target_betas=None, report_path=None):
     m = {"v_template": V, "f": F.astype(np.int32), "shapedirs": shapedirs,
          "posedirs": np.zeros((V.shape[0], 3, NUM_POSE_FEATURES)), "weights": W,
          "kintree_table": np.array([SMPL_PARENTS, list(range(NUM_JOINTS))], dtype=np.int32), "J_regressor": jr}
-    write_h5(m, out_path, "MakeHuman hm08 base human (CC0) via data_tools/makehuman_to_smpl.py",
-             [meaning for meaning, _ in SHAPE_DIRECTIONS])
+    smpl_pkl_to_h5.write_h5(m, out_path, "MakeHuman hm08 base human (CC0) via data_tools/makehuman_to_smpl.py",
+                            [meaning for meaning, _ in SHAPE_DIRECTIONS])
     if target_betas:
         write_target_betas(target_betas, rows)
     report = {
@@ -582,30 +584,6 @@ def write_target_betas(path, rows):
                 continue  # not in the shape space (a muscle x weight corner): least squares would extrapolate
             fh.write(name + "," + ",".join(f"{b:.6f}" for b in beta) + "\n")
     os.replace(tmp, path)
-
-
-def write_h5(m, out_path, source, meanings):
-    import h5py
-    tmp = out_path + ".partial"
-    strings = h5py.string_dtype("utf-8")
-    try:
-        with h5py.File(tmp, "w") as h:
-            h.create_dataset("meta/format_version", data=np.array([FORMAT_VERSION], dtype=np.int64))
-            h.create_dataset("meta/units", data=np.array(["metres"], dtype=object), dtype=strings)
-            h.create_dataset("meta/source", data=np.array([source], dtype=object), dtype=strings)
-            for key in ("v_template", "f", "shapedirs", "posedirs", "weights", "kintree_table"):
-                h.create_dataset(key, data=m[key], compression="gzip" if m[key].size >= 4096 else None)
-            jr = m["J_regressor"]
-            h.create_dataset("J_regressor_csr/indptr", data=jr.indptr.astype(np.int32))
-            h.create_dataset("J_regressor_csr/indices", data=jr.indices.astype(np.int32))
-            h.create_dataset("J_regressor_csr/data", data=jr.data.astype(np.float64))
-            h.create_dataset("J_regressor_csr/shape", data=np.array(jr.shape, dtype=np.int32))
-            h.create_dataset("joint_names", data=np.array(SMPL_JOINT_NAMES, dtype=object), dtype=strings)
-            h.create_dataset("shape_meanings", data=np.array(meanings, dtype=object), dtype=strings)
-        os.replace(tmp, out_path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
 
 
 def self_test():

@@ -200,7 +200,9 @@ def extract(raw, path):
     return out
 
 
-def write_h5(m, out_path, source):
+def write_h5(m, out_path, source, shape_meanings=None):
+    """Writes the model atomically (OUT.partial, renamed); shape_meanings: one string per shape
+    direction (optional, /shape_meanings)."""
     import h5py
     tmp = out_path + ".partial"
     strings = h5py.string_dtype("utf-8")
@@ -217,6 +219,8 @@ def write_h5(m, out_path, source):
             h.create_dataset("J_regressor_csr/data", data=jr.data.astype(np.float64))
             h.create_dataset("J_regressor_csr/shape", data=np.array(jr.shape, dtype=np.int32))
             h.create_dataset("joint_names", data=np.array(SMPL_JOINT_NAMES, dtype=object), dtype=strings)
+            if shape_meanings:
+                h.create_dataset("shape_meanings", data=np.array(shape_meanings, dtype=object), dtype=strings)
         os.replace(tmp, out_path)
     finally:
         if os.path.exists(tmp):

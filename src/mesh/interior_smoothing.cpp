@@ -52,15 +52,7 @@ InteriorSmoothingReport smooth_interior_nodes(TetMesh& mesh, const std::vector<N
   rep.inverted_before = before.inverted;
 
   const std::vector<std::vector<int>> star = tet_stars(mesh);
-  std::vector<std::vector<int>> nbr(N);
-  for (int t = 0; t < mesh.num_elements(); ++t)
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        if (i != j) nbr[mesh.elements(t, i)].push_back(mesh.elements(t, j));
-  for (auto& v : nbr) {
-    std::sort(v.begin(), v.end());
-    v.erase(std::unique(v.begin(), v.end()), v.end());
-  }
+  const std::vector<std::vector<int>> nbr = tet_node_neighbours(mesh);
   std::vector<Vec3> lattice;
   for (int a = -1; a <= 1; ++a)
     for (int b = -1; b <= 1; ++b)

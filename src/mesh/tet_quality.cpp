@@ -104,6 +104,19 @@ std::vector<std::vector<int>> tet_stars(const TetMesh& mesh) {
   return star;
 }
 
+std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& mesh) {
+  std::vector<std::vector<int>> nbr(mesh.num_nodes());
+  for (int t = 0; t < mesh.num_elements(); ++t)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (i != j) nbr[mesh.elements(t, i)].push_back(mesh.elements(t, j));
+  for (auto& n : nbr) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return nbr;
+}
+
 double star_min_dihedral(const TetMesh& mesh, const std::vector<int>& star, int n, const Vec3& x) {
   double worst = std::numeric_limits<double>::infinity();
   for (int t : star) {

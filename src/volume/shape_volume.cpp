@@ -32,20 +32,6 @@ std::string ShapeReport::describe() const {
 
 namespace {
 
-// Nodes sharing a tet with each node (sorted, unique).
-std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& tet) {
-  std::vector<std::vector<int>> nbr(tet.num_nodes());
-  for (int t = 0; t < tet.num_elements(); ++t)
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        if (i != j) nbr[tet.elements(t, i)].push_back(tet.elements(t, j));
-  for (auto& n : nbr) {
-    std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
-  }
-  return nbr;
-}
-
 // Per-node thickness scale: the mean of the region scales of the incident
 // tets, then Jacobi-smoothed over the tet graph so the layer thickness varies
 // smoothly across region borders (a step would shear the tets there).

@@ -48,6 +48,9 @@ TetQualityReport tet_quality_report(const TetMesh& mesh, double sliver_threshold
 /// Star of every node: the tets incident to it (#N lists of tet indices).
 std::vector<std::vector<int>> tet_stars(const TetMesh& mesh);
 
+/// Nodes sharing a tet with each node (#N sorted, unique lists).
+std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& mesh);
+
 /// Smallest dihedral angle (deg) over the tets `star` with node `n` placed at
 /// `x` instead of its mesh position; -1 if any of them is inverted or flat
 /// (signed volume <= 0). The local objective of node relocation.
