@@ -200,7 +200,9 @@ def extract(raw, path):
     return out
 
 
-def write_h5(m, out_path, source):
+def write_h5(m, out_path, source, shape_meanings=None):
+    """Writes the model atomically (OUT.partial, renamed); shape_meanings: one string per shape
+    direction (optional, /shape_meanings)."""
     import h5py
     tmp = out_path + ".partial"
     def strings(h, name, values):
@@ -223,6 +225,8 @@ def write_h5(m, out_path, source):
             h.create_dataset("J_regressor_csr/data", data=jr.data.astype(np.float64))
             h.create_dataset("J_regressor_csr/shape", data=np.array(jr.shape, dtype=np.int32))
             strings(h, "joint_names", SMPL_JOINT_NAMES)
+            if shape_meanings:
+                strings(h, "shape_meanings", shape_meanings)
         os.replace(tmp, out_path)
     finally:
         if os.path.exists(tmp):

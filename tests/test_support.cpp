@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <sys/wait.h>
 
@@ -25,7 +26,9 @@ TempDir::~TempDir() {
 }
 
 std::string shared_data(const std::string& rel) {
-  std::filesystem::path p = std::filesystem::path(SFLSH_SHARED_DIR) / "data" / rel;
+  // $SFLSH_SHARED_DIR overrides the build-time ../shared (a git worktree elsewhere).
+  const char* env = std::getenv("SFLSH_SHARED_DIR");
+  std::filesystem::path p = std::filesystem::path(env && *env ? env : SFLSH_SHARED_DIR) / "data" / rel;
   return std::filesystem::exists(p) ? p.string() : std::string();
 }
 

@@ -22,7 +22,7 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-/// Path of ../shared/data/<rel> or "" when the shared folder is absent
+/// Path of ../shared/data/<rel> ($SFLSH_SHARED_DIR/data/<rel> if set) or "" when absent
 /// (tests then GTEST_SKIP() with a message saying so).
 std::string shared_data(const std::string& rel);
 

@@ -8,33 +8,10 @@
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
-namespace {
-
-// Smallest dihedral angle over the tets in `star` with node n at x; -1 if
-// any of them is inverted or degenerate.
-double star_quality(const TetMesh& mesh, const std::vector<int>& star, int n, const Vec3& x) {
-  double worst = std::numeric_limits<double>::infinity();
-  for (int t : star) {
-    Vec3 p[4];
-    for (int i = 0; i < 4; ++i) {
-      const int m = mesh.elements(t, i);
-      p[i] = m == n ? x : Vec3(mesh.nodes.row(m).transpose());
-    }
-    const TetQuality q = tet_quality(p[0], p[1], p[2], p[3]);
-    if (!(q.signed_volume > 0)) return -1.0;
-    worst = std::min(worst, q.min_dihedral_deg);
-  }
-  return worst;
-}
-
-}  // namespace
-
 SliverRepairReport repair_slivers(TetMesh& mesh, const std::vector<char>& movable, const SliverRepairOptions& o) {
   const int N = mesh.num_nodes(), T = mesh.num_elements();
   require(int(movable.size()) == N, "repair_slivers: ", movable.size(), " movable flags for ", N, " nodes");
-  std::vector<std::vector<int>> star(N);
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 4; ++i) star[mesh.elements(t, i)].push_back(t);
+  const std::vector<std::vector<int>> star = tet_stars(mesh);
   std::vector<Vec3> lattice;
   for (int a = -1; a <= 1; ++a)
     for (int b = -1; b <= 1; ++b)
@@ -74,12 +51,12 @@ SliverRepairReport repair_slivers(TetMesh& mesh, const std::vector<char>& movabl
           const Vec3 nrm = (f[1] - f[0]).cross(f[2] - f[0]);
           if (nrm.norm() > 0) dirs.push_back(nrm.normalized()), dirs.push_back(-nrm.normalized());
         }
-        double best = star_quality(mesh, star[n], n, x);
+        double best = star_min_dihedral(mesh, star[n], n, x);
         Vec3 best_x = x;
         for (double step : {0.3, 0.1, 0.03})
           for (const Vec3& d : dirs) {
             const Vec3 y = x + step * h * d;
-            const double q = star_quality(mesh, star[n], n, y);
+            const double q = star_min_dihedral(mesh, star[n], n, y);
             if (q > best + 1e-9) best = q, best_x = y;
           }
         if (best_x != x) {

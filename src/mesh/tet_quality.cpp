@@ -97,6 +97,41 @@ std::string TetQualityReport::describe() const {
   return os.str();
 }
 
+std::vector<std::vector<int>> tet_stars(const TetMesh& mesh) {
+  std::vector<std::vector<int>> star(mesh.num_nodes());
+  for (int t = 0; t < mesh.num_elements(); ++t)
+    for (int i = 0; i < 4; ++i) star[mesh.elements(t, i)].push_back(t);
+  return star;
+}
+
+std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& mesh) {
+  std::vector<std::vector<int>> nbr(mesh.num_nodes());
+  for (int t = 0; t < mesh.num_elements(); ++t)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        if (i != j) nbr[mesh.elements(t, i)].push_back(mesh.elements(t, j));
+  for (auto& n : nbr) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return nbr;
+}
+
+double star_min_dihedral(const TetMesh& mesh, const std::vector<int>& star, int n, const Vec3& x) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (int t : star) {
+    Vec3 p[4];
+    for (int i = 0; i < 4; ++i) {
+      const int m = mesh.elements(t, i);
+      p[i] = m == n ? x : Vec3(mesh.nodes.row(m).transpose());
+    }
+    const TetQuality q = tet_quality(p[0], p[1], p[2], p[3]);
+    if (!(q.signed_volume > 0)) return -1.0;
+    worst = std::min(worst, q.min_dihedral_deg);
+  }
+  return worst;
+}
+
 int orient_tets_positively(TetMesh& mesh) {
   int flipped = 0;
   for (int t = 0; t < mesh.num_elements(); ++t) {

@@ -177,7 +177,9 @@ std::string key_prefix(const BodyModel& model, const PrecomputeOptions& o) {
     << template_cache_key(model, o.template_stage);
   const ShapeOptions& so = o.shape_stage;
   s << "|shape," << so.min_depth << ',' << so.scale_smoothing_iterations << ',' << so.capsule_percentile << ','
-    << so.max_relax_rounds << ',' << so.min_dihedral_deg << "|thickness";
+    << so.max_relax_rounds << ',' << so.min_dihedral_deg << ',' << so.quality_floor_deg << ',' << so.smoothing.target_deg
+    << ',' << so.smoothing.passes << ',' << so.smoothing.max_displacement_fraction << ',' << so.skin_slide_fraction
+    << "|thickness";
   for (const auto& [region, scale] : o.thickness.scale) s << ',' << region << '=' << scale;
   s << "|handles," << o.handles << ',' << o.handle_positions.rows();
   for (Eigen::Index i = 0; i < o.handle_positions.size(); ++i) s << ',' << o.handle_positions.data()[i];

@@ -8,6 +8,7 @@
 #include "sflsh/core/timer.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/point_embedding.hpp"
+#include "sflsh/volume/surface_query.hpp"
 
 namespace sflsh {
 
@@ -17,24 +18,19 @@ std::string ShapeReport::describe() const {
      << " skin vertices outside the tet mesh, farthest " << max_embedding_distance * 1e3 << " mm; shape stage "
      << seconds << " s";
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
+  if (smoothing.passes > 0)
+    os << "\n  interior optimization: min dihedral " << smoothing.min_dihedral_before << " -> "
+       << smoothing.min_dihedral_after << " deg, tets below " << smoothing.below_target_before << " -> "
+       << smoothing.below_target_after << " (target), " << smoothing.nodes_moved << " nodes moved (max "
+       << smoothing.max_displacement * 1e3 << " mm) in " << smoothing.passes << " passes";
+  if (skin_smoothing.passes > 0)
+    os << "; with skin nodes sliding on the skin: min dihedral " << skin_smoothing.min_dihedral_after << " deg, "
+       << skin_smoothing.below_target_after << " tets below target, " << skin_smoothing.nodes_moved
+       << " nodes moved (max " << skin_smoothing.max_displacement * 1e3 << " mm)";
   return os.str();
 }
 
 namespace {
-
-// Nodes sharing a tet with each node (sorted, unique).
-std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& tet) {
-  std::vector<std::vector<int>> nbr(tet.num_nodes());
-  for (int t = 0; t < tet.num_elements(); ++t)
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        if (i != j) nbr[tet.elements(t, i)].push_back(tet.elements(t, j));
-  for (auto& n : nbr) {
-    std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
-  }
-  return nbr;
-}
 
 // Per-node thickness scale: the mean of the region scales of the incident
 // tets, then Jacobi-smoothed over the tet graph so the layer thickness varies
@@ -173,6 +169,46 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       if (mark[n]) relax[n] = last ? 0.0 : 0.5 * relax[n];
   }
   for (int n = 0; n < N; ++n) out.report.num_relaxed_nodes += relax[n] < 1.0;
+
+  // Interior optimization: the thickness map (and a shape that stretches the
+  // layer unevenly) flattens some tets of the thin shell, where nearly every
+  // tet joins skin nodes to bone-surface nodes; the skin stays, the
+  // bone-surface nodes slide across their paths (their depth along the path
+  // is kept to first order), interior nodes move freely.
+  // The floor: quality_floor_deg, or the template's own minimum if that is lower (a shape
+  // is not asked to make the mesh better than the template).
+  const double quality_floor = std::min(o.quality_floor_deg, tet_quality_report(tv.tet).min_dihedral_deg);
+  if (o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+    std::vector<NodeFreedom> freedom(N, NodeFreedom::Free);
+    Points normals = Points::Zero(N, 3);
+    for (int i = 0; i < tv.inner_nodes.size(); ++i) {
+      const int n = tv.inner_nodes[i];
+      const Vec3 path = gb.row(n) - sb.row(n);
+      if (path.norm() > 1e-9) {
+        freedom[n] = NodeFreedom::Slide;
+        normals.row(n) = path.normalized().transpose();
+      } else {
+        freedom[n] = NodeFreedom::Fixed;
+      }
+    }
+    std::vector<char> on_skin(N, 0);
+    for (int i = 0; i < tv.outer_nodes.size(); ++i) on_skin[tv.outer_nodes[i]] = 1;
+    for (int n = 0; n < N; ++n)
+      if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
+    out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
+    if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor) {
+      // Skin nodes of the tets still below the floor slide along the shaped skin.
+      const SurfaceQuery skin(v_shaped, F);
+      for (int t = 0; t < tv.tet.num_elements(); ++t)
+        if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
+          for (int i = 0; i < 4; ++i)
+            if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
+      InteriorSmoothingOptions so = o.smoothing;
+      so.max_displacement_fraction = o.skin_slide_fraction;
+      out.report.skin_smoothing = smooth_interior_nodes(av.tet, freedom, normals, so,
+                                                        [&](const Vec3& y) { return skin.closest_point(y); });
+    }
+  }
   out.report.quality = tet_quality_report(av.tet);
   require(out.report.quality.num_inverted == 0, "shape_volume: ", out.report.quality.num_inverted,
           " tets inverted for this shape (smallest volume ", out.report.quality.min_volume,

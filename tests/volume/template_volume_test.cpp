@@ -233,8 +233,11 @@ TEST(TemplateVolume, BoundaryRolesDepthsAndWeights) {
 TEST(ShapeVolume, SameTopologyForTwoShapesAndBlendShapesAlongPaths) {
   const TemplateVolume& tv = tmpl();
   const VecX b1 = (VecX(2) << 1.0, 0.0).finished(), b2 = (VecX(2) << -0.5, 1.0).finished();
-  const ShapedVolume s1 = shape_volume(tv, body(), b1, ThicknessMap::uniform());
-  const ShapedVolume s2 = shape_volume(tv, body(), b2, ThicknessMap::uniform());
+  // The placement rule itself, without the interior optimization (tested below).
+  ShapeOptions placement_only;
+  placement_only.smoothing.passes = 0;
+  const ShapedVolume s1 = shape_volume(tv, body(), b1, ThicknessMap::uniform(), placement_only);
+  const ShapedVolume s2 = shape_volume(tv, body(), b2, ThicknessMap::uniform(), placement_only);
   EXPECT_TRUE(s1.avatar.tet.elements == tv.tet.elements);
   EXPECT_TRUE(s2.avatar.tet.elements == tv.tet.elements);
   EXPECT_EQ(s1.report.quality.num_inverted, 0);
@@ -262,7 +265,10 @@ TEST(ShapeVolume, ThicknessMapMovesTheBoneSurfaceNotTheSkin) {
   ThicknessMap thick;
   for (const auto& r : body_region_names()) thick.scale[r] = 1.3;
   const VecX beta = VecX::Zero(2);
-  const ShapedVolume s = shape_volume(tv, body(), beta, thick);
+  // The placement rule itself, without the interior optimization (checked after).
+  ShapeOptions placement_only;
+  placement_only.smoothing.passes = 0;
+  const ShapedVolume s = shape_volume(tv, body(), beta, thick, placement_only);
   EXPECT_EQ(s.report.quality.num_inverted, 0);
   // Thickening a layer about one tet thick by 30 % squeezes some tets
   // tangentially; the few that would drop below 2 deg keep a smaller scale.
@@ -283,6 +289,33 @@ TEST(ShapeVolume, ThicknessMapMovesTheBoneSurfaceNotTheSkin) {
     ++checked;
   }
   EXPECT_GT(checked, 5);
+
+  // With the interior optimization (default options): the tets the thickened layer flattened
+  // get back to min(8 deg, the template's minimum), skin nodes stay on the skin surface, bone
+  // nodes slide across their (radial) paths: their radius changes only to second order.
+  const double q0 = tet_quality_report(tv.tet).min_dihedral_deg;
+  ASSERT_LT(s.report.quality.min_dihedral_deg, std::min(8.0, q0)) << "nothing for the optimization to do";
+  const ShapedVolume o = shape_volume(tv, body(), beta, thick);
+  EXPECT_EQ(o.report.quality.num_inverted, 0);
+  EXPECT_GE(o.report.quality.min_dihedral_deg, std::min(8.0, q0) - 1e-9) << o.report.describe();
+  EXPECT_GT(o.report.smoothing.nodes_moved, 0);
+  const SurfaceQuery skin(body().v_template, body().faces);
+  int slid = 0;
+  for (int i = 0; i < tv.outer_nodes.size(); ++i) {  // a moved skin node is projected onto the skin
+    const int n = tv.outer_nodes[i];
+    const bool moved = (o.avatar.tet.nodes.row(n) - s.avatar.tet.nodes.row(n)).norm() > 0;
+    slid += moved;
+    const double d = skin.distance(o.avatar.tet.nodes.row(n).transpose());
+    EXPECT_LT(d, moved ? 1e-9 : skin.distance(s.avatar.tet.nodes.row(n).transpose()) + 1e-12);
+  }
+  EXPECT_LE(slid, o.report.skin_smoothing.nodes_moved);
+  for (int i = 0; i < tv.inner_nodes.size(); ++i) {
+    const int n = tv.inner_nodes[i];
+    const double moved = (o.avatar.tet.nodes.row(n) - s.avatar.tet.nodes.row(n)).norm();
+    if (std::abs(tv.tet.nodes(n, 1)) > 0.1 || moved == 0) continue;
+    const double r0 = std::hypot(s.avatar.tet.nodes(n, 0), s.avatar.tet.nodes(n, 2));
+    EXPECT_LT(std::abs(std::hypot(o.avatar.tet.nodes(n, 0), o.avatar.tet.nodes(n, 2)) - r0), moved * moved / r0 + 1e-9);
+  }
 }
 
 TEST(ShapeVolume, NoInvertedTetsOverTheBetaRange) {

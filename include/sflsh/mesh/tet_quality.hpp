@@ -2,6 +2,7 @@
 // Element quality of tetrahedral meshes: signed volume, dihedral angles and
 // radius ratio per tet, and a summary for reports (precompute, inspect).
 #include <string>
+#include <vector>
 
 #include "sflsh/core/types.hpp"
 #include "sflsh/mesh/tet_mesh.hpp"
@@ -43,6 +44,17 @@ struct TetQualityReport {
 /// Measures every tet of `mesh`; `sliver_threshold_deg` sets the count
 /// `num_below_threshold`.
 TetQualityReport tet_quality_report(const TetMesh& mesh, double sliver_threshold_deg = 8.0);
+
+/// Star of every node: the tets incident to it (#N lists of tet indices).
+std::vector<std::vector<int>> tet_stars(const TetMesh& mesh);
+
+/// Nodes sharing a tet with each node (#N sorted, unique lists).
+std::vector<std::vector<int>> tet_node_neighbours(const TetMesh& mesh);
+
+/// Smallest dihedral angle (deg) over the tets `star` with node `n` placed at
+/// `x` instead of its mesh position; -1 if any of them is inverted or flat
+/// (signed volume <= 0). The local objective of node relocation.
+double star_min_dihedral(const TetMesh& mesh, const std::vector<int>& star, int n, const Vec3& x);
 
 /// Reorders the nodes of every negatively oriented tet (swaps nodes 2 and 3)
 /// so all tets are positively oriented; returns how many were flipped.

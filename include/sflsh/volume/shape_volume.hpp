@@ -5,6 +5,7 @@
 // local frames, capsules).
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/body_model.hpp"
+#include "sflsh/mesh/interior_smoothing.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 #include "sflsh/volume/template_volume.hpp"
 #include "sflsh/volume/thickness_map.hpp"
@@ -28,6 +29,22 @@ struct ShapeOptions {
   /// (a floor, not a target: changing the layer thickness alters every
   /// tet's angles a little).
   double min_dihedral_deg = 2.0;
+  /// The shaped mesh is optimized (below) only if some tet's smallest
+  /// dihedral angle is below this (deg) and below the template mesh's
+  /// smallest; otherwise the nodes stay exactly where the shape and thickness
+  /// map put them.
+  double quality_floor_deg = 8.0;
+  /// Optimization of the placed mesh (after the thickness map): interior
+  /// nodes move freely, bone-surface nodes slide across their paths (in the
+  /// plane orthogonal to skeleton point -> skin point), skin nodes stay, until
+  /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it.
+  InteriorSmoothingOptions smoothing;
+  /// If tets stay below quality_floor_deg after that (tets with all four nodes on the
+  /// skin, where the shape flattened the skin), a second round also lets the
+  /// skin nodes of the remaining bad tets slide along the shaped skin (each
+  /// candidate projected onto it, so they stay exactly on the skin), at most
+  /// this fraction of their shortest edge. 0 skips the round.
+  double skin_slide_fraction = 0.3;
 };
 
 struct ShapeReport {
@@ -36,6 +53,9 @@ struct ShapeReport {
   int num_embedded_outside = 0;
   /// Nodes whose thickness scale was relaxed towards 1 to avoid inverted tets.
   int num_relaxed_nodes = 0;
+  /// The interior/bone-surface node optimization (quality before/after it),
+  /// and the second round with skin nodes sliding (passes = 0 if not run).
+  InteriorSmoothingReport smoothing, skin_smoothing;
   double seconds = 0;
   std::string describe() const;
 };
@@ -61,7 +81,10 @@ struct ShapedVolume {
 /// k = 1 the nodes are template nodes + Σ β_b node_shapedirs[b] up to the
 /// residual's change. Where the thickened layer would invert tets, k is
 /// relaxed towards 1 locally (ShapeReport::num_relaxed_nodes); likewise
-/// where it would flatten tets (ShapeOptions::min_dihedral_deg). Throws if
+/// where it would flatten tets (ShapeOptions::min_dihedral_deg). Then the
+/// interior nodes and the bone-surface nodes (sliding across their paths) are
+/// moved to raise the smallest dihedral angle (ShapeOptions::smoothing); the
+/// skin nodes stay where the shape puts them. Throws if
 /// tets stay inverted (then the shape itself folds the mesh) or `tv` was
 /// built from another model.
 ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,

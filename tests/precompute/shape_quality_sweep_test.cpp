@@ -1,0 +1,135 @@
+// Quality of the shaped tet mesh over the shape space (slow; run explicitly):
+//
+//   SFLSH_SWEEP_MODEL=procedural|model.h5  SFLSH_SWEEP_CORNERS=1024  SFLSH_SWEEP_RANDOM=100 \
+//   SFLSH_SWEEP_BETAS=extra.csv  nice build/test_precompute --gtest_also_run_disabled_tests \
+//       --gtest_filter='ShapeQualitySweep.*'
+//
+// Shapes: corners of [-3, 3]^10 (the first 10 betas; SFLSH_SWEEP_CORNERS < 1024 takes that many
+// corners drawn with a fixed seed, always including all -3 and all +3), uniform random draws in
+// the same box (seed 2026), and the rows of an optional CSV (`name,b0,b1,...`, e.g. the
+// MakeHuman targets from data_tools/makehuman_to_smpl.py --target-betas). Each goes through the
+// shape stage's geometry (shape_volume, default thickness map); every one must keep its minimum
+// dihedral angle >= 8 deg with no inverted tet. Template stage from the precompute cache.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/timer.hpp"
+#include "sflsh/precompute/precompute.hpp"
+#include "sflsh/volume/body_regions.hpp"
+#include "sflsh/volume/shape_volume.hpp"
+
+namespace sflsh {
+namespace {
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::atoi(v) : fallback;
+}
+
+TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
+  const char* model_env = std::getenv("SFLSH_SWEEP_MODEL");
+  const BodyModel model = load_body_model(model_env && *model_env ? model_env : "procedural");
+  PrecomputeOptions po;
+  po.cache_dir = default_cache_dir();
+  const TemplateVolume tv = cached_template_volume(model, po);
+  const int B = model.num_betas(), D = std::min(B, 10);
+  const double range = 3.0;
+
+  std::vector<std::pair<std::string, VecX>> shapes;
+  const int corners = std::clamp(env_int("SFLSH_SWEEP_CORNERS", 1 << D), 0, 1 << D);
+  std::vector<int> ids(1 << D);
+  for (int i = 0; i < (1 << D); ++i) ids[i] = i;
+  if (corners < (1 << D)) {
+    std::mt19937 pick(2026);
+    std::shuffle(ids.begin() + 1, ids.end() - 1, pick);  // keep all -3 (0) and all +3 (last) first
+    std::swap(ids[1], ids.back());
+    ids.resize(corners);
+  }
+  for (int id : ids) {
+    VecX b = VecX::Zero(B);
+    std::string name = "corner ";
+    for (int d = 0; d < D; ++d) b[d] = (id >> d & 1) ? range : -range, name += (id >> d & 1) ? '+' : '-';
+    shapes.emplace_back(name, b);
+  }
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> U(-range, range);
+  for (int i = 0, n = env_int("SFLSH_SWEEP_RANDOM", 100); i < n; ++i) {
+    VecX b = VecX::Zero(B);
+    for (int d = 0; d < D; ++d) b[d] = U(rng);
+    shapes.emplace_back("random " + std::to_string(i), b);
+  }
+  if (const char* csv = std::getenv("SFLSH_SWEEP_BETAS"); csv && *csv) {
+    std::ifstream in(csv);
+    ASSERT_TRUE(in.good()) << csv;
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::istringstream ls(line);
+      std::string name, tok;
+      std::getline(ls, name, ',');
+      std::vector<double> v;
+      while (std::getline(ls, tok, ',')) v.push_back(std::stod(tok));
+      shapes.emplace_back(name, Eigen::Map<VecX>(v.data(), v.size()).head(std::min<int>(v.size(), B)));
+    }
+  }
+
+  double worst = 180, worst_before = 180, total_s = 0;
+  std::string worst_name;
+  int failed = 0, max_moved = 0;
+  for (const auto& [name, betas] : shapes) {
+    Timer t;
+    try {
+      const ShapedVolume s = shape_volume(tv, model, betas, ThicknessMap::defaults());
+      const TetQualityReport& q = s.report.quality;
+      const double sec = t.seconds();
+      total_s += sec;
+      std::printf("%-24s min dihedral %6.3f deg (before the interior optimization %6.3f), %d below 8, %d inverted, "
+                  "%d nodes moved, %d tets below target on fixed nodes only, %d skin nodes slid (max %.2f mm), %.2f s\n",
+                  name.c_str(), q.min_dihedral_deg, s.report.smoothing.min_dihedral_before, q.num_below_threshold,
+                  q.num_inverted, s.report.smoothing.nodes_moved, s.report.smoothing.below_target_all_fixed,
+                  s.report.skin_smoothing.nodes_moved, s.report.skin_smoothing.max_displacement * 1e3, sec);
+      if (q.num_below_threshold > 0) {  // where the remaining bad tets are
+        std::map<std::string, int> where;
+        std::vector<char> outer(tv.tet.num_nodes(), 0);
+        for (int i = 0; i < tv.outer_nodes.size(); ++i) outer[tv.outer_nodes[i]] = 1;
+        for (int t = 0; t < s.avatar.tet.num_elements(); ++t) {
+          if (tet_quality(s.avatar.tet, t).min_dihedral_deg >= 8.0) continue;
+          int skin = 0, simulated = 0;
+          for (int i = 0; i < 4; ++i) {
+            skin += outer[s.avatar.tet.elements(t, i)];
+            simulated += s.avatar.node_role[s.avatar.tet.elements(t, i)] == int(NodeRole::Simulated);
+          }
+          ++where[body_region_names()[s.avatar.tet_region[t]] + (simulated ? " simulated" : " dirichlet-only") +
+                  ", " + std::to_string(skin) + " skin nodes"];
+        }
+        for (const auto& [k, n] : where) std::printf("    below 8 deg: %d tets in %s\n", n, k.c_str());
+      }
+      std::fflush(stdout);
+      if (q.min_dihedral_deg < worst) worst = q.min_dihedral_deg, worst_name = name;
+      worst_before = std::min(worst_before, s.report.smoothing.min_dihedral_before);
+      max_moved = std::max(max_moved, s.report.smoothing.nodes_moved);
+      const bool ok = q.min_dihedral_deg >= 8.0 && q.num_inverted == 0;
+      failed += !ok;
+      EXPECT_TRUE(ok) << name << ": min dihedral " << q.min_dihedral_deg << ", " << q.num_inverted << " inverted";
+    } catch (const Error& e) {
+      ++failed;
+      ADD_FAILURE() << name << ": " << e.what();
+    }
+  }
+  std::printf("%s: %zu shapes (%d corners of [-3,3]^%d), worst min dihedral %.3f deg (%s; %.3f before the interior "
+              "optimization), %d failed, at most %d nodes moved, %.1f s per shape\n",
+              model.source.c_str(), shapes.size(), corners, D, worst, worst_name.c_str(), worst_before, failed,
+              max_moved, total_s / std::max<size_t>(1, shapes.size()));
+}
+
+}  // namespace
+}  // namespace sflsh
