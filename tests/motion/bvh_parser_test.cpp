@@ -93,7 +93,7 @@ TEST(BvhParser, MalformedInputNamesFileLineAndExpectation) {
        "'MOTION' while joint 'Hips' opened at line 2 has no closing '}'"},
       {"extra close brace", "}\nMOTION", "}\n}\nMOTION", 30, "unexpected '}'"},
       {"bad offset", "OFFSET 8.0 -5.0 0.0", "OFFSET 8.0 -5.0", 18, "expected an OFFSET coordinate"},
-      {"bad frame time", "Frame Time: 0.04", "Frame Time: fast", 32, "expected a frame time"},
+      {"bad frame time", "Frame Time: 0.04", "Frame Time: fast", 32, "expected 'Frame Time' in seconds"},
       {"zero frame time", "Frame Time: 0.04", "Frame Time: 0", 32, "must be positive"},
       {"bad frames", "Frames: 3", "Frames: three", 31, "expected a frame count"},
       {"no hierarchy", "HIERARCHY", "HIERARCH", 1, "expected 'HIERARCHY'"},
