@@ -34,7 +34,7 @@ struct SimulateArgs {
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
   long inject_nan_at_step = 0;  // test only (hidden option)
-  bool line_search = false, use_file_betas = false, start_at_rest = false;
+  bool line_search = false, use_file_betas = false, start_at_rest = false, volume_per_tet = false;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
   double tracking_tolerance_mm = 20;
   bool strict = false;
@@ -112,6 +112,7 @@ void run_simulate(const SimulateArgs& a) {
   o.sim.newton.max_rotation_step = a.max_rotation_step;
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
+  o.sim.mean_dilatation = !a.volume_per_tet;
   require(!a.seconds_given || (std::isfinite(a.seconds) && a.seconds > 0),
           "--seconds must be a positive number of seconds, got ", a.seconds);
   require(std::isfinite(a.output_fps) && a.output_fps > 0, "--output-fps must be positive, got ", a.output_fps);
@@ -220,6 +221,8 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   auto* seconds = cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
   cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
   cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
+  cmd->add_flag("--volume-per-tet", a->volume_per_tet,
+                "Constrain every tet's volume change on its own (no mean dilatation per handle cell; locks the subspace)");
   cmd->add_option("--max-rotation-step", a->max_rotation_step,
                   "Largest bone rotation per Newton iteration (rad); larger steps are scaled down as a whole "
                   "(counted as damped); <= 0: no cap")

@@ -172,6 +172,44 @@ Cubature full_cubature(const TetMesh& mesh, const VecXi& node_role, bool simulat
   return cub;
 }
 
+Cubature nodal_cubature(const TetMesh& mesh, const VecX& tet_density, const VecXi& node_role) {
+  const int T = mesh.num_elements(), N = mesh.num_nodes();
+  require(tet_density.size() == 0 || tet_density.size() == T, "nodal_cubature: tet_density has ", tet_density.size(),
+          " entries, expected #T = ", T);
+  require(node_role.size() == 0 || node_role.size() == N, "nodal_cubature: node_role has ", node_role.size(),
+          " entries, expected #N = ", N);
+  const VecX volume = fem::tet_volumes(mesh);
+  VecX mass = VecX::Zero(N);
+  std::vector<int> first_tet(size_t(N), -1), corner(size_t(N), -1);
+  std::vector<char> keep(size_t(N), node_role.size() == 0 ? 1 : 0);
+  for (int t = 0; t < T; ++t) {
+    const double rho = tet_density.size() ? tet_density[t] : 1.0;
+    bool any_simulated = false;
+    for (int c = 0; c < 4; ++c) any_simulated |= node_role.size() && node_role[mesh.elements(t, c)] == int(NodeRole::Simulated);
+    for (int c = 0; c < 4; ++c) {
+      const int n = mesh.elements(t, c);
+      mass[n] += rho * volume[t] / 4.0;
+      if (any_simulated) keep[size_t(n)] = 1;
+      if (first_tet[size_t(n)] < 0) first_tet[size_t(n)] = t, corner[size_t(n)] = c;
+    }
+  }
+  std::vector<int> nodes;
+  for (int n = 0; n < N; ++n)
+    if (keep[size_t(n)] && first_tet[size_t(n)] >= 0) nodes.push_back(n);
+  Cubature cub;
+  const Eigen::Index S = Eigen::Index(nodes.size());
+  cub.elements.resize(S);
+  cub.barycentric = MatXr::Zero(S, 4);
+  cub.weights.resize(S);
+  for (Eigen::Index s = 0; s < S; ++s) {
+    const int n = nodes[size_t(s)], t = first_tet[size_t(n)];
+    cub.elements[s] = t;
+    cub.barycentric(s, corner[size_t(n)]) = 1.0;
+    cub.weights[s] = mass[n] / (tet_density.size() ? tet_density[t] : 1.0);
+  }
+  return cub;
+}
+
 Points cubature_points(const TetMesh& mesh, const Cubature& cubature) {
   Points p(cubature.size(), 3);
   for (int s = 0; s < cubature.size(); ++s) {

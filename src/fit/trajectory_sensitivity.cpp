@@ -110,11 +110,11 @@ SurfaceRun simulate_surface(const Avatar& avatar, const FitParameters& params, c
   std::vector<Mat3> A_prev, A_cur;  // inertia samples' skinning rotations at t − h and t
   if (jacobian) {
     Timer timer;
-    es = std::make_unique<ElasticSensitivity>(*av, params.elastic(&elastic_index));
     require(inertia != nullptr, "simulate_surface: the model has no inertia term");
     // K: the elastic Hessian at rest (exactly the quadratic part; damping's K₀).
     const ElasticTerm* elastic = model.find_term<ElasticTerm>(0);
     require(elastic != nullptr, "simulate_surface: the model has no elastic term");
+    es = std::make_unique<ElasticSensitivity>(*av, params.elastic(&elastic_index), elastic->mean_dilatation());
     StepContext ctx;
     ctx.avatar = av.get();
     ctx.layout = model.bodies()[0].layout;

@@ -19,7 +19,7 @@ std::shared_ptr<const Model> avatar_model(std::shared_ptr<const Avatar> avatar, 
   require(o.damping >= 0, "SimulatorOptions::damping = ", o.damping, " s, expected >= 0");
   ModelBuilder builder(model_options(o));
   const int body = builder.add_body({name, std::move(avatar), o.bones_dynamic});
-  if (o.soft_tissue_terms) add_soft_tissue_terms(builder, body, {true, o.damping});
+  if (o.soft_tissue_terms) add_soft_tissue_terms(builder, body, {true, o.damping, o.mean_dilatation});
   if (skeleton) add_skeleton_terms(builder, body, *skeleton);
   return builder.build();
 }

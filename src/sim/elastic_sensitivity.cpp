@@ -6,6 +6,7 @@
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/energies/sample_hessian.hpp"
+#include "sflsh/sim/linearized_stiffness.hpp"
 
 namespace sflsh {
 namespace {
@@ -49,7 +50,7 @@ RegionMaterial perturbed_material(const RegionMaterial& m, MaterialParameter kin
   return r;
 }
 
-ElasticSensitivity::ElasticSensitivity(const Avatar& a, std::vector<RegionParameter> params)
+ElasticSensitivity::ElasticSensitivity(const Avatar& a, std::vector<RegionParameter> params, bool mean_dilatation)
     : params_(std::move(params)), num_reduced_(a.num_reduced()) {
   for (const RegionParameter& p : params_)
     require(p.region >= 0 && p.region < int(a.materials.size()), "ElasticSensitivity: region ", p.region,
@@ -85,36 +86,29 @@ ElasticSensitivity::ElasticSensitivity(const Avatar& a, std::vector<RegionParame
     samples_.push_back(std::move(s));
   }
 
-  // ∂K/∂p: the exact quadratic ½ zᵀ K z sums every moving tet's volume · H2 (elastic.hpp).
-  dK_.assign(params_.size(), MatX::Zero(num_reduced_, num_reduced_));
-  if (params_.empty()) return;
-  const VecX volume = fem::tet_volumes(a.tet);
-  std::vector<Eigen::Matrix<double, 3, 9>> T;
-  std::vector<int> handle;
-  std::vector<Vec3> d;
-  for (int t = 0; t < a.tet.num_elements(); ++t) {
-    const int r = a.tet_region.size() ? a.tet_region[t] : 0;
-    if (region_params[r].empty()) continue;
-    handle.clear();
-    d.clear();
-    for (const auto& [h, v] : fem::handle_gradients(a.tet, grads[t], a.W, a.node_role, t))
-      handle.push_back(h), d.push_back(v);
-    if (handle.empty()) continue;
-    const Mat3 frame = tet_frame(a, t);
-    const RegionMaterial& mat = tet_material(a, t);
-    for (int i : region_params[r]) {
-      if (params_[i].kind == MaterialParameter::LogFungC) continue;  // H2 does not depend on c
-      Mat9 dH2;
-      if (params_[i].kind == MaterialParameter::LogYoung) {
+  // ∂K/∂p: the exact quadratic ½ zᵀ K z sums every moving tet's volume · H2,
+  // linearly in H2 also with mean dilatation (linearized_stiffness.hpp).
+  dK_.assign(params_.size(), MatX());
+  for (int i = 0; i < int(params_.size()); ++i) {
+    const RegionParameter p = params_[i];
+    if (p.kind == MaterialParameter::LogFungC) {  // H2 does not depend on c
+      dK_[i] = MatX::Zero(num_reduced_, num_reduced_);
+      continue;
+    }
+    dK_[i] = linearized_stiffness(a, [&a, p](int t, Mat9& dH2) {
+      if ((a.tet_region.size() ? a.tet_region[t] : 0) != p.region) return false;
+      const Mat3 frame = tet_frame(a, t);
+      const RegionMaterial& mat = tet_material(a, t);
+      if (p.kind == MaterialParameter::LogYoung) {
         dH2 = linearized_hessian(MaterialPoint(mat, frame));  // H2 ∝ the Young's factor
       } else {
-        dH2 = (linearized_hessian(MaterialPoint(perturbed_material(mat, params_[i].kind, kParameterStep), frame)) -
-               linearized_hessian(MaterialPoint(perturbed_material(mat, params_[i].kind, -kParameterStep), frame))) /
+        dH2 = (linearized_hessian(MaterialPoint(perturbed_material(mat, p.kind, kParameterStep), frame)) -
+               linearized_hessian(MaterialPoint(perturbed_material(mat, p.kind, -kParameterStep), frame))) /
               (2 * kParameterStep);
         dH2 = 0.5 * (dH2 + dH2.transpose()).eval();
       }
-      add_sample_hessian(volume[t] * dH2, handle.data(), d.data(), int(handle.size()), 0, dK_[i], T);
-    }
+      return true;
+    }, mean_dilatation);
   }
 }
 

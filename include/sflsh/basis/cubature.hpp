@@ -52,6 +52,15 @@ Cubature stratified_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<doub
 /// (`node_role` != Simulated; empty = keep all) are skipped when `simulated_only`.
 Cubature full_cubature(const TetMesh& mesh, const VecXi& node_role = VecXi(), bool simulated_only = false);
 
+/// Lumped nodal integration, the full-FEM reference's mass model: one sample
+/// at each node n that lies in a tet with a Simulated node (all nodes when
+/// `node_role` is empty), placed in the first tet e₀ containing n with
+/// barycentric coordinate 1 at n, weight (Σ_{e∋n} ρ_e V_e / 4) / ρ_{e₀} (m^3), so that
+/// ρ_{e₀}·weight is the node's lumped mass m_n. `tet_density` #T (kg/m^3;
+/// empty = uniform). As the inertia cubature it makes the reduced kinetic
+/// energy Σ_n m_n/2 |ẋ_n|² exactly the reference's projected onto the basis.
+Cubature nodal_cubature(const TetMesh& mesh, const VecX& tet_density = VecX(), const VecXi& node_role = VecXi());
+
 /// Cubature against full integration over all tets (relative errors are
 /// (cubature − full) / full).
 struct CubatureErrors {

@@ -15,6 +15,9 @@ struct SoftTissueOptions {
   /// Stiffness-proportional damping β (s) of the soft tissue (energies/damping.hpp); 0 = none
   /// (backward Euler's own numerical damping remains).
   double damping = 0.0;
+  /// Average the volume change of the small-strain energy per cell of tets
+  /// (linearized_stiffness.hpp; against the subspace's volumetric locking).
+  bool mean_dilatation = true;
 };
 
 /// Adds, in this order, inertia, elastic, gravity (if enabled and the model's

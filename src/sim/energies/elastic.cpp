@@ -7,6 +7,7 @@
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/sim/energies/sample_hessian.hpp"
+#include "sflsh/sim/linearized_stiffness.hpp"
 
 namespace sflsh {
 
@@ -31,8 +32,11 @@ const RegionMaterial& tet_material(const Avatar& a, int t) {
   return a.materials[r];
 }
 
-ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic)
-    : num_reduced_(a.num_reduced()), project_psd_(project_psd), exact_quadratic_(exact_quadratic) {
+ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic, bool mean_dilatation)
+    : num_reduced_(a.num_reduced()),
+      project_psd_(project_psd),
+      exact_quadratic_(exact_quadratic),
+      mean_dilatation_(exact_quadratic && mean_dilatation) {
   const Cubature& cub = a.elastic;
   require(cub.weights.size() == cub.size(), "ElasticTerm: elastic cubature has ", cub.size(), " elements but ",
           cub.weights.size(), " weights");
@@ -54,20 +58,7 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   }
   if (!exact_quadratic_) return;
   // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
-  K_ = MatX::Zero(num_reduced_, num_reduced_);
-  const VecX volume = fem::tet_volumes(a.tet);
-  std::vector<Eigen::Matrix<double, 3, 9>> T;
-  std::vector<int> handle;
-  std::vector<Vec3> d;
-  for (int t = 0; t < a.tet.num_elements(); ++t) {
-    handle.clear();
-    d.clear();
-    for (const auto& [h, v] : fem::handle_gradients(a.tet, grads[t], a.W, a.node_role, t))
-      handle.push_back(h), d.push_back(v);
-    if (handle.empty()) continue;
-    const Mat9 H2 = volume[t] * linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
-    add_sample_hessian(H2, handle.data(), d.data(), int(handle.size()), 0, K_, T);
-  }
+  K_ = linearized_stiffness(a, material_tet_stiffness(a), mean_dilatation_);
 }
 
 Mat3 ElasticTerm::deformation_gradient(int k, const VecX& z) const {

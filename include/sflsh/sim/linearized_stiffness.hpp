@@ -1,0 +1,48 @@
+#pragma once
+// The exact small-strain stiffness of the reduced model (issue 13):
+//   ½ zᵀ K z = Σ_t V_t ½ vec(∇u_t)ᵀ H_t vec(∇u_t),   ∇u_t = Σ_h z_h d_{t,h}ᵀ,
+// over every tet that moves, H_t = ∂²Ψ₂/∂F² of the tet's material and frame
+// (material.hpp, linearized_hessian), d_{t,h} = Σ_n W_{n,h} ∇N_n.
+//
+// Mean dilatation ("B-bar", Hughes 1980; Simo, Taylor & Pister 1985). A smooth
+// subspace of K handles cannot follow the near-isochoric motion of tissue with
+// ν = 0.45 tet by tet: constraining the volume change of every one of ~40k tets
+// with 3K DoFs locks it. Measured on the default body (`sflsh bench`, jump):
+// the Galerkin projection of the full-FEM reference onto the basis (elastic
+// on all tets, the reference's lumped masses) misses it by rel_err 0.35 while
+// the basis can represent it to 0.13 (the floor). With `mean_dilatation` the
+// trace of ∇u_t is replaced by its volume mean over the tet's cell, the tets
+// whose largest summed handle weight is handle k:
+//   ∇ū_t = ∇u_t − (tr ∇u_t / 3) I + (θ_c / 3) I,   θ_c = Σ_{s∈c} V_s tr ∇u_s / V_c,
+// so each cell keeps one volume constraint (K of them for 3K DoFs) and the
+// deviatoric (shape-changing) part stays exact per tet. With one tet per cell
+// this is the plain assembly. K is assembled as
+//   Σ_t V_t Bᵀ P H_t P B + Σ_c [(a_c g_cᵀ + g_c a_cᵀ)/3 + s_c g_c g_cᵀ / 9],
+// P = I − v vᵀ/3 (v = vec I) the deviatoric projector, g_c = ∂θ_c/∂z,
+// a_c = Σ_{t∈c} V_t Bᵀ P H_t v, s_c = Σ_{t∈c} V_t vᵀ H_t v.
+#include <functional>
+
+#include "sflsh/asset/avatar.hpp"
+#include "sflsh/core/types.hpp"
+#include "sflsh/sim/material.hpp"
+
+namespace sflsh {
+
+/// Per tet t: writes H_t (9x9 over vec(∇u) column-major, Pa, symmetric,
+/// without the volume) and returns true, or returns false to leave t out
+/// (the tet still counts towards its cell's mean dilatation).
+using TetStiffness = std::function<bool(int t, Mat9& H)>;
+
+/// Cell of every tet (#T): the handle whose weight summed over the tet's four
+/// nodes is largest, or −1 when no handle weights the tet (it does not move).
+VecXi dilatation_cells(const Avatar& avatar);
+
+/// K (3K by 3K, N/m: z in m) of `avatar` for per-tet Hessians `tet_stiffness`;
+/// with `mean_dilatation` the tets' volume change is averaged over
+/// dilatation_cells (see above), otherwise every tet is integrated as is.
+MatX linearized_stiffness(const Avatar& avatar, const TetStiffness& tet_stiffness, bool mean_dilatation);
+
+/// The material's own H_t (linearized_hessian of tet_material and tet_frame).
+TetStiffness material_tet_stiffness(const Avatar& avatar);
+
+}  // namespace sflsh
