@@ -24,6 +24,7 @@ namespace sflsh {
 
 struct BenchOptions {
   bool quick = false;                     ///< fewer variants, 0.5 s of motion
+  bool peer = true;                       ///< the Bullet 3 peer rows (bullet_peer.hpp)
   std::string motion = "builtin:jump";
   double seconds = 0;                     ///< 0: 0.5 s quick, 2 s full
   std::string model = "procedural";
@@ -42,7 +43,7 @@ struct RegionError {
 };
 
 struct BenchRow {
-  std::string method;  ///< reference | reduced | skinning
+  std::string method;  ///< reference | reduced | peer | skinning
   std::string label;   ///< the variant in words (table, plot legend; not in the CSV)
   int handles = 0;
   double dt = 0;
