@@ -1,6 +1,7 @@
 #include "sflsh/bench/bullet_peer.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <BulletSoftBody/btDeformableBodySolver.h>
 #include <BulletSoftBody/btDeformableGravityForce.h>
@@ -38,6 +39,7 @@ namespace {
 /// Bullet's deformable solver with its Newton settings readable.
 struct PeerSolver : btDeformableBodySolver {
   int newton_iterations() const { return m_maxNewtonIterations; }
+  void set_newton_iterations(int n) { m_maxNewtonIterations = n; }
 };
 
 btVector3 bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
@@ -125,7 +127,8 @@ BulletPeer::BulletPeer(std::shared_ptr<const Avatar> avatar, BulletPeerOptions o
   // under gravity (measured: a free tet stays put).
   w.world->setImplicit(true);
   w.world->setUseProjection(true);
-  w.world->setLineSearch(false);
+  w.world->setLineSearch(options_.line_search);
+  if (options_.newton_iterations > 0) w.solver.set_newton_iterations(options_.newton_iterations);
 
   std::vector<btVector3> x(static_cast<size_t>(N));
   for (int n = 0; n < N; ++n) x[size_t(n)] = bt(a.tet.nodes.row(n).transpose());
@@ -201,6 +204,19 @@ Points BulletPeer::soft_displacement() const {
     u.row(n) = A.lu().solve((x.row(n) - rest.row(n)).transpose()).transpose();
   }
   return u;
+}
+
+double BulletPeer::min_volume_ratio() const {
+  const btSoftBody& b = *world_->body;
+  double J = std::numeric_limits<double>::infinity();
+  for (int t = 0; t < b.m_tetras.size(); ++t) {
+    const btSoftBody::Tetra& tet = b.m_tetras[t];
+    const btVector3 c1 = tet.m_n[1]->m_x - tet.m_n[0]->m_x, c2 = tet.m_n[2]->m_x - tet.m_n[0]->m_x,
+                    c3 = tet.m_n[3]->m_x - tet.m_n[0]->m_x;
+    const btMatrix3x3 Ds(c1.x(), c2.x(), c3.x(), c1.y(), c2.y(), c3.y(), c1.z(), c2.z(), c3.z());
+    J = std::min(J, double((Ds * tet.m_Dm_inverse).determinant()));
+  }
+  return J;
 }
 
 LameParameters BulletPeer::bullet_lame() const { return {world_->elastic->m_mu, world_->elastic->m_lambda}; }

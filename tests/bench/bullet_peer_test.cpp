@@ -37,6 +37,7 @@ TEST(BulletPeer, BuildsOurMeshWithOurMasses) {
   EXPECT_GT(prescribed, 0);
   EXPECT_LT((peer.node_masses() - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.maxCoeff());
   EXPECT_GE(peer.newton_iterations(), 1);
+  EXPECT_NEAR(peer.min_volume_ratio(), 1.0, 1e-12);  // at rest
 }
 
 TEST(BulletPeer, PrescribedNodesFollowTheSkinnedRestPositions) {

@@ -68,6 +68,10 @@ struct BulletPeerOptions {
   /// Re-pose each tetra's rest shape to the skinned rest positions every step
   /// (see above); false: Bullet's rest shape is the unposed mesh.
   bool rest_follows_skinning = false;
+  /// Newton iterations of Bullet's implicit solve at most (0: Bullet's default).
+  int newton_iterations = 0;
+  /// Bullet's backtracking line search on its step energy (setLineSearch).
+  bool line_search = false;
 };
 
 /// One avatar's tet mesh as a Bullet deformable body (see the file comment).
@@ -101,6 +105,9 @@ class BulletPeer {
   /// #N by 3 soft displacement u_n (m, unposed) at the current bones; rows of
   /// prescribed nodes are 0.
   Points soft_displacement() const;
+  /// Smallest det F over Bullet's tetras at the current positions (volume
+  /// ratio to the rest shape; ≤ 0: an inverted tetra).
+  double min_volume_ratio() const;
   /// (μ_B, λ_B) held by Bullet's Neo-Hookean force (Pa).
   LameParameters bullet_lame() const;
   /// Small-strain (μ, λ) Bullet applies in tet t: ¾μ_B s_t, (λ_B − ⅝μ_B) s_t with
