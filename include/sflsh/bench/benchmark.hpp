@@ -2,7 +2,8 @@
 // `sflsh bench`: run time against error. On one avatar shape and one motion
 // (bones prescribed, soft tissue dynamic) it runs the full-FEM reference
 // (Newton to convergence, CHOLMOD), the reduced solver at several handle counts,
-// time steps and Newton iteration counts, and skinning only (u = 0), and
+// time steps and Newton iteration counts, the Bullet 3 peer (bullet_peer.hpp;
+// stopped at its first inverted tetra) and skinning only (u = 0), and
 // compares the soft displacement of the skin in the simulated region at common
 // frame times (30 per second).
 //
