@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -150,7 +151,7 @@ TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
   const nlohmann::json r = last_json_line(out);
   ASSERT_TRUE(r.contains("controls")) << out;
   const nlohmann::json& c = r["controls"];
-  EXPECT_NEAR(c.value("stiffness", 0.0), 3.0, 1e-9);
+  EXPECT_NEAR(c.value("stiffness", 0.0), std::sqrt(10.0), 1e-9);  // the slider at 0.5 (log10 scale)
   EXPECT_EQ(c.value("paused", false), true);
   EXPECT_EQ(c.value("held", false), true);
   EXPECT_EQ(c.value("step_count", 0), 1);
@@ -160,7 +161,7 @@ TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
   EXPECT_EQ(c.value("reset_max_u_mm", -1.0), 0.0);
   ASSERT_EQ(c["reset_device"].size(), 3u);
   EXPECT_NEAR(double(c["reset_device"][1]), 0.045, 1e-9);  // the keyframe start, not the dragged pose
-  EXPECT_EQ(c.value("reset_stiffness", 0.0), 3.0);
+  EXPECT_NEAR(c.value("reset_stiffness", 0.0), std::sqrt(10.0), 1e-9);
   EXPECT_GT(c.value("resumed_t", 0.0), 0.0);
 }
 

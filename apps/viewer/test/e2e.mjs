@@ -6,7 +6,7 @@
 //        [--controls 1] [--gl swiftshader|angle-swiftshader|in-process|egl]
 // live: waits for frames, Shift-drags the tool by DX,DY,DZ metres (default 0,-0.03,0)
 // in the view plane, holds, and reports what the server sent (contact, max |u|);
-// with --controls, then moves the stiffness slider to 3×, pauses, steps, resets
+// with --controls, then moves the stiffness slider to 10^0.5 ≈ 3.16×, pauses, steps, resets
 // and resumes with the page's controls and reports what the frames said;
 // playback: presses play and checks the time advances. Always: display fps,
 // bandwidth, input-to-photon latencies, pixel statistics of the rendered image.
@@ -31,10 +31,10 @@ async function controls(page, info) {
   const c = {};
   await page.evaluate(() => {
     const s = document.getElementById('stiffness');
-    s.value = String(Math.log10(3));
+    s.value = '0.5';  // 10^0.5 = 3.16×
     s.dispatchEvent(new Event('change'));
   });
-  await waitInfo(page, () => Math.abs(window.sflshViewer.lastInfo.stiffness - 3) < 1e-9);
+  await waitInfo(page, () => Math.abs(window.sflshViewer.lastInfo.stiffness - Math.sqrt(10)) < 1e-9);
   c.stiffness = (await info()).stiffness;
   await page.click('#pause');
   c.paused = await waitInfo(page, () => window.sflshViewer.lastInfo.paused);
