@@ -41,6 +41,17 @@ struct LiveViewer::Impl {
     for (int b = 0; b < s.num_bodies(); ++b) bodies.push_back({PosedPoints::at_surface(s.avatar(b)), {}, Points()});
   }
 
+  /// Builds the frame of the current state and hands it to the server.
+  void publish(const LiveViewer& viewer) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ViewerFrame f = viewer.frame(last_status);
+    frame_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ++frames_built;
+    max_u = std::max(max_u, f.stats.max_displacement);
+    if (f.stats.contact) ++contact_frames;
+    server->publish(std::move(f));
+  }
+
   static bool same_bones(const std::vector<Isometry>& a, const std::vector<Isometry>& b) {
     if (a.size() != b.size()) return false;
     for (size_t j = 0; j < a.size(); ++j)
@@ -177,39 +188,41 @@ ViewerFrame LiveViewer::frame(const LiveRunStatus& status) const {
 
 void LiveViewer::install(LiveRunHooks& hooks) {
   Impl* d = impl_.get();
-  // A step asked for while paused is taken here, one solver step (run_live's
-  // real-time frame would take up to max_substeps after the pause), and
-  // passed to the run's own after_step hook (result and tool-log rows).
-  auto after_step = hooks.after_step;
-  hooks.before_frame = [this, d, after_step](SceneSession& s) {
+  // The run's own after_step hook (result and tool-log rows), called for every step.
+  auto run_after_step = hooks.after_step;
+  // Applies the page's controls; while paused, serves the held state and takes
+  // single steps asked for (one solver step each: run_live's real-time frame
+  // would take up to max_substeps after the pause) until resumed.
+  auto controls = [this, d, run_after_step](SceneSession& s) {
     bool step = d->apply_controls();
-    // Paused: keep serving the held state and reading controls until resumed.
     while (d->paused && interrupt_signal() == 0) {
       if (step) {
         const StepReport& rep = s.advance();
         ++d->paused_steps;
-        if (after_step) after_step(s, rep);
-        d->server->publish(frame(d->last_status));
+        if (run_after_step) run_after_step(s, rep);
+        d->publish(*this);
       } else if (d->server->frame_due()) {
-        d->server->publish(frame(d->last_status));
+        d->publish(*this);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       step = d->apply_controls();
     }
+  };
+  hooks.before_frame = [controls](SceneSession& s) {
+    controls(s);
     return true;
   };
-  hooks.after_frame = [this, d](const SceneSession& s, const LiveRunStatus& status) {
+  // Between the substeps too: a behind real-time frame runs up to max_substeps,
+  // and the page's poses and the display rate should not wait for its end.
+  hooks.after_step = [this, d, run_after_step, controls](const SceneSession&, const StepReport& rep) {
+    if (run_after_step) run_after_step(d->session, rep);
+    d->step_ms_avg = d->step_ms_avg == 0 ? rep.ms_total : 0.99 * d->step_ms_avg + 0.01 * rep.ms_total;
+    controls(d->session);
+    if (d->server->frame_due()) d->publish(*this);
+  };
+  hooks.after_frame = [this, d](const SceneSession&, const LiveRunStatus& status) {
     d->last_status = status;
-    const double ms = s.last_report().ms_total;
-    d->step_ms_avg = d->step_ms_avg == 0 ? ms : 0.95 * d->step_ms_avg + 0.05 * ms;
-    if (!d->server->frame_due()) return;
-    const auto t0 = std::chrono::steady_clock::now();
-    ViewerFrame f = frame(status);
-    d->frame_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    ++d->frames_built;
-    d->max_u = std::max(d->max_u, f.stats.max_displacement);
-    if (f.stats.contact) ++d->contact_frames;
-    d->server->publish(std::move(f));
+    if (d->server->frame_due()) d->publish(*this);
   };
 }
 

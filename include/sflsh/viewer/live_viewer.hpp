@@ -25,8 +25,11 @@ class LiveViewer {
              bool allow_reset = true);
   ~LiveViewer();
 
-  /// Sets hooks.before_frame (apply the page's controls; hold while paused)
-  /// and hooks.after_frame (publish a frame when one is due).
+  /// Sets hooks.before_frame (apply the page's controls; hold while paused),
+  /// wraps hooks.after_step (the run's own hook first; then the controls and,
+  /// when one is due, a frame: between substeps, so a real-time frame that
+  /// runs max_substeps delays neither) and sets hooks.after_frame (a frame
+  /// when due). Install after setting the run's own after_step.
   void install(LiveRunHooks& hooks);
   /// The frame of the session's current state (public for tests).
   ViewerFrame frame(const LiveRunStatus& status) const;
