@@ -47,7 +47,8 @@ const view = $('view');
 const params = new URLSearchParams(location.search);
 // (No preserveDrawingBuffer: pixelStats renders and reads back in the same task.)
 const renderer = new THREE.WebGLRenderer({ antialias: params.get('aa') !== '0' });
-renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+// ?res=R draws at R device pixels per CSS pixel (e.g. 0.5: a quarter of the fragments, for software renderers).
+renderer.setPixelRatio(Number(params.get('res')) > 0 ? Math.min(Number(params.get('res')), 2) : Math.min(window.devicePixelRatio, 2));
 view.appendChild(renderer.domElement);
 const scene3 = new THREE.Scene();
 scene3.background = new THREE.Color(0x20232a);
