@@ -9,6 +9,7 @@ PACKAGES=(
   libassimp-dev libhdf5-dev libceres-dev libgoogle-glog-dev libgflags-dev
   libgtest-dev libgmock-dev libcli11-dev libyaml-cpp-dev libzip-dev zlib1g-dev
   libtbb-dev libpng-dev
+  libbullet-dev  # sflsh bench's peer: Bullet 3 deformable FEM (bullet-float64)
   python3-numpy python3-scipy python3-h5py
   python3-distributed
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer, ASan, UBSan

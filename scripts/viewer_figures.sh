@@ -5,8 +5,13 @@
 # drags the probe 3 cm sideways (input-to-photon) and Shift+wheels it 48 mm into
 # the belly, holds HOLD seconds, and reports display and received frame rates,
 # bandwidth, the input-to-photon median and pixel statistics; the server prints
-# RTF, step times and its own bandwidth at exit. Writes OUT/{e2e.json,run.txt,live.png}.
+# RTF, step times, its own bandwidth and frame-build time at exit. The page
+# reports its own time per stage (decode, apply, normals, draw call). Writes
+# OUT/{e2e.json,run.txt,live.png,load.txt}.
+#   [GL=swiftshader|angle-swiftshader|in-process|egl] [QUERY='?aa=0'] \
 #   scripts/viewer_figures.sh AVATAR.h5 [OUT=out/viewer] [HOLD=10]
+# GL picks chromium's GPU-less WebGL back end (apps/viewer/test/e2e.mjs);
+# QUERY the page's options (?aa=0: no antialiasing; &mat=standard: PBR skin).
 # Needs a built sflsh, chromium and apps/viewer/node_modules (scripts/setup.sh).
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
@@ -14,6 +19,8 @@ AVATAR="$(realpath "${1:?usage: viewer_figures.sh AVATAR.h5 [OUT] [HOLD]}")"
 OUT="${2:-out/viewer}"
 HOLD="${3:-10}"
 PORT="${PORT:-8093}"
+GL="${GL:-swiftshader}"
+QUERY="${QUERY:-?aa=0}"
 mkdir -p "$OUT"
 cat > "$OUT/probe_belly.yaml" <<YAML
 solver: {dt: 1/500, seconds: 600}
@@ -30,8 +37,8 @@ YAML
 SERVER=$!
 trap 'kill -TERM $SERVER 2>/dev/null || true' EXIT
 for _ in $(seq 100); do grep -q serving "$OUT/run.txt" && break; sleep 0.2; done
-echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)" | tee "$OUT/load.txt"
-node "$ROOT/apps/viewer/test/e2e.mjs" --url "http://127.0.0.1:$PORT/" --query '?aa=0' --mode live \
+echo "load before: $(cut -d' ' -f1-3 /proc/loadavg) ($(date -u +%H:%M) UTC, GL=$GL QUERY=$QUERY)" | tee "$OUT/load.txt"
+node "$ROOT/apps/viewer/test/e2e.mjs" --url "http://127.0.0.1:$PORT/" --query "$QUERY" --gl "$GL" --mode live \
   --drag 0.03,0,0 --wheel 12 --seconds "$HOLD" --screenshot "$OUT/live.png" | tee "$OUT/e2e.json"
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)" | tee -a "$OUT/load.txt"
 kill -TERM $SERVER

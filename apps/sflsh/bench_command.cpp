@@ -16,7 +16,7 @@ namespace sflsh::cli {
 namespace {
 
 struct BenchArgs {
-  bool quick = false, no_cache = false;
+  bool quick = false, no_cache = false, peer = true;
   std::string motion = "builtin:jump", out = "bench", model = "procedural", betas, handles, cache_dir;
   double seconds = 0;
   bool seconds_given = false;
@@ -30,6 +30,7 @@ void run_bench(const BenchArgs& a) {
 
   BenchOptions o;
   o.quick = a.quick;
+  o.peer = a.peer;
   o.motion = a.motion;
   o.seconds = a.seconds;
   o.model = a.model;
@@ -82,6 +83,7 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
   cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
+  cmd->add_flag("--peer,!--no-peer", a->peer, "Run the Bullet 3 deformable-FEM peer rows (default on)");
   cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.md, bench.svg)")->capture_default_str();
   cmd->callback([a, seconds] {
     a->seconds_given = seconds->count() > 0;

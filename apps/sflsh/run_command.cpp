@@ -136,7 +136,8 @@ void run_scene_live(const RunArgs& a) {
   std::unique_ptr<viewer::LiveViewer> view;
   if (a.serve) {
     view = std::make_unique<viewer::LiveViewer>(session, viewer::ViewerServerOptions{a.bind, a.port},
-                                                std::filesystem::path(a.scene).filename().string());
+                                                std::filesystem::path(a.scene).filename().string(),
+                                                /*allow_reset=*/a.out.empty() && a.tool_log.empty());
     view->install(hooks);
   }
   LiveRunOptions lo;

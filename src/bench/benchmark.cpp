@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 
+#include "sflsh/bench/bullet_peer.hpp"
 #include "sflsh/bench/subspace_floor.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
@@ -162,6 +163,35 @@ Points surface_from_nodes(const Avatar& a, const Points& nodal) {
     u.row(v) = s.transpose();
   }
   return u;
+}
+
+/// The Bullet peer on the same mesh, bones and h; skin soft displacement as
+/// for the full-FEM reference (nodal u through the surface embedding). Stops
+/// at the first step that inverts a tetra (*diverged_at = that step, else 0):
+/// the trace then holds the frames before it.
+Trace run_peer(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
+               bool rest_follows_skinning, int* newton_iterations, long* diverged_at) {
+  BulletPeerOptions po;
+  po.h = h;
+  po.rest_follows_skinning = rest_follows_skinning;
+  BulletPeer peer(avatar, po);
+  *newton_iterations = peer.newton_iterations();
+  *diverged_at = 0;
+  peer.reset(target_bones(*avatar, motion.sample(0)));
+  Trace tr;
+  tr.u.push_back(surface_from_nodes(*avatar, peer.soft_displacement()));
+  const int per = steps_per_frame(h);
+  const long steps = std::lround(seconds / h);
+  Progress p(std::string("bench: Bullet peer") + (rest_follows_skinning ? " (rest re-skinned)" : ""), steps);
+  for (long s = 1; s <= steps && *diverged_at == 0; ++s) {
+    tr.ms.push_back(peer.step(target_bones(*avatar, motion.sample(s * h))));
+    if (!(peer.min_volume_ratio() > 0)) *diverged_at = s;
+    else if (s % per == 0) tr.u.push_back(surface_from_nodes(*avatar, peer.soft_displacement()));
+    p.update(s);
+  }
+  p.finish();
+  if (*diverged_at) log_info("bench: the Bullet peer inverted a tetra at step " + std::to_string(*diverged_at) + " of " + std::to_string(steps));
+  return tr;
 }
 
 /// The floor trace of basis a.W: the skin displacement of the mass-weighted
@@ -349,6 +379,14 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   auto lumped_exact = std::make_shared<Avatar>(*exact);
   lumped_exact->inertia = lumped->inertia;
   reduced(lumped_exact, K, h, 1, "elastic on all tets + lumped nodal inertia", false);
+  for (bool reskin : o.peer ? std::vector<bool>{false, true} : std::vector<bool>{}) {
+    int iters = 0;
+    long diverged = 0;
+    const Trace tr = run_peer(default_avatar, motion, o.seconds, h, reskin, &iters, &diverged);
+    std::string label = std::string("Bullet 3 Neo-Hookean FEM") + (reskin ? ", rest re-skinned" : "");
+    if (diverged) label += " (diverged at step " + std::to_string(diverged) + "; error over the " + std::to_string(tr.u.size()) + " frames before)";
+    add(tr, nullptr, "peer", label, 0, h, iters, false);
+  }
   add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }
@@ -477,6 +515,8 @@ void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& 
       label = r.label;
       if (r.method == "skinning")
         color = "#d62728";
+      else if (r.method == "peer")
+        color = "#8c564b";
       else if (r.newton_iters > 1)
         color = "#2ca02c";
       else if (r.dt != rows[0].dt)

@@ -72,7 +72,7 @@ LiveRunStatus run_live(SceneSession& s, const LiveRunOptions& opt, const LiveRun
   const long end_step =
       s.steps_done() + (opt.seconds > 0 ? std::max(1L, long(std::llround(opt.seconds / s.dt()))) : s.total_steps());
   LiveRunStatus st;
-  const double start = wall_seconds(), sim_start = s.time();
+  const double start = wall_seconds();
   double next_status = start + 1.0;
   size_t status_from = 0;
   auto one_step = [&] {
@@ -87,7 +87,7 @@ LiveRunStatus run_live(SceneSession& s, const LiveRunOptions& opt, const LiveRun
   auto end_frame = [&] {
     ++st.frames;
     st.wall_time = wall_seconds() - start;
-    st.sim_time = s.time() - sim_start;
+    st.sim_time = double(st.steps) * s.dt();  // not s.time(): SceneSession::reset() sends it back to 0
     st.rtf = st.wall_time > 0 ? st.sim_time / st.wall_time : 0.0;
     if (hooks.after_frame) hooks.after_frame(s, st);
     if (opt.progress && wall_seconds() >= next_status) {
@@ -135,7 +135,7 @@ LiveRunStatus run_live(SceneSession& s, const LiveRunOptions& opt, const LiveRun
     }
   }
   st.wall_time = wall_seconds() - start;
-  st.sim_time = s.time() - sim_start;
+  st.sim_time = double(st.steps) * s.dt();
   st.rtf = st.wall_time > 0 ? st.sim_time / st.wall_time : 0.0;
   return st;
 }

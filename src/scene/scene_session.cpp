@@ -1,5 +1,6 @@
 #include "sflsh/scene/scene_session.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +15,8 @@
 #include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/energies/damping.hpp"
+#include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/energies/virtual_coupling.hpp"
 #include "sflsh/sim/finite_guard.hpp"
@@ -119,6 +122,7 @@ struct SceneTool {
   std::unique_ptr<PoseTrack> track;  ///< keyframes or pose file (null: live only)
   RigidObjectModel shape;            ///< when desc->has_shape
   std::vector<GraspController> grasps;   ///< per body (when the tool has sensors)
+  std::vector<GraspController> grasps_at_start;  ///< `grasps` before the first step (reset)
   std::vector<std::string> anchor_keys;  ///< per body: the anchor term's tool name
   std::string contact_term;              ///< "contact:<tool>": its contact terms' name
   std::string anchor_prefix;             ///< "anchor:<tool>@": its anchor terms' names start so
@@ -161,6 +165,45 @@ struct SceneTool {
   }
 };
 
+/// A term whose energy, gradient and Hessian are `scale` times another's: the
+/// stiffness scale of a body's elastic and damping terms. Scaling every Young's
+/// modulus and the Fung c of a material by s (Poisson's ratio kept) scales its
+/// StVK stiffness C, c and the barrier's κ (∝ Young) by s, and
+/// Ψ = (sc/2)(exp(2 sΨ_stvk / (sc)) − 1) + s Ψ_vol = s Ψ: the elastic energy,
+/// and the damping's K₀, are exactly s times the unscaled ones (up to
+/// rounding). Quantities reported are the inner term's (elastic and damping
+/// report none).
+class ScaledTerm final : public EnergyTerm {
+ public:
+  ScaledTerm(std::shared_ptr<const EnergyTerm> inner, double scale) : inner_(std::move(inner)), scale_(scale) {}
+  std::string name() const override { return inner_->name(); }
+  BodyBlocks blocks() const override { return inner_->blocks(); }
+  std::unique_ptr<TermCache> make_cache() const override { return inner_->make_cache(); }
+  void begin_step(const StepContext& ctx) const override { inner_->begin_step(ctx); }
+  bool active(const StepContext& ctx) const override { return inner_->active(ctx); }
+  std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override {
+    return inner_->report(ctx, q);
+  }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override {
+    if (!grad && !hess) return scale_ * inner_->compute(ctx, q, nullptr, nullptr);
+    // The inner term adds into its own zeroed buffers (per thread: groups step in parallel).
+    thread_local VecX g;
+    thread_local MatX H;
+    if (grad) g.setZero(grad->size());
+    if (hess) H.setZero(hess->rows(), hess->cols());
+    VecRef gv(g);
+    MatRef Hv(H);
+    const double e = inner_->compute(ctx, q, grad ? &gv : nullptr, hess ? &Hv : nullptr);
+    if (grad) *grad += scale_ * g;
+    if (hess) *hess += scale_ * H;
+    return scale_ * e;
+  }
+
+ private:
+  std::shared_ptr<const EnergyTerm> inner_;
+  double scale_;
+};
+
 bool same_sample(const PoseSample& a, const PoseSample& b) {
   return a.position == b.position && a.orientation.coeffs() == b.orientation.coeffs() && a.closure == b.closure;
 }
@@ -180,8 +223,17 @@ struct SceneSession::Impl {
   StepInputs in;
   StepReport report;
   std::vector<SceneToolEvent> events;
+  std::shared_ptr<const Model> base_model;  ///< the scene's model at stiffness scale 1
+  State initial;                            ///< the state at t = 0 (reset)
+  std::vector<double> stiffness;            ///< per body (scene order): its stiffness scale
 
   void build();
+  /// Puts the tools at their t = 0 device poses (coupled tools' bodies in `s`)
+  /// and starts their recordings.
+  void start_tools(State& s);
+  /// Rebuilds the simulator's model from base_model with the stiffness
+  /// scales (its elastic and damping terms wrapped), keeping the state.
+  void apply_stiffness();
   Isometry object_pose(const SceneObject& o, double t) const {
     if (o.model_index < 0) return object_pose_at(*o.desc, t);
     return Isometry(sim->state(o.model_index).bones[0] * o.model.shape_in_body);
@@ -424,6 +476,16 @@ void SceneSession::Impl::build() {
       G_prev.linear() = Eigen::AngleAxisd(-w * h, o.desc->angular_velocity / w).toRotationMatrix() * G.linear();
     s.bodies[o.model_index] = {Configuration{{G}, VecX(0)}, Configuration{{G_prev}, VecX(0)}};
   }
+  start_tools(s);
+  sim->set_state(s);
+  in.bodies.resize(sim->model().bodies().size());
+  base_model = sim->model_ptr();
+  initial = s;
+  stiffness.assign(bodies.size(), 1.0);
+  for (SceneTool& t : tools) t.grasps_at_start = t.grasps;
+}
+
+void SceneSession::Impl::start_tools(State& s) {
   for (SceneTool& t : tools) {
     t.device_now = t.track->at(0.0, t.hold ? PoseInterpolation::kHold : PoseInterpolation::kLinear);
     t.state.device = t.device_now;
@@ -437,8 +499,26 @@ void SceneSession::Impl::build() {
       t.recorded = t.device_now;
     }
   }
-  sim->set_state(s);
-  in.bodies.resize(sim->model().bodies().size());
+}
+
+void SceneSession::Impl::apply_stiffness() {
+  const Model& base = *base_model;
+  std::shared_ptr<const Model> model = base_model;
+  if (std::any_of(stiffness.begin(), stiffness.end(), [](double s) { return s != 1.0; })) {
+    std::vector<double> per_model_body(base.bodies().size(), 1.0);
+    for (size_t i = 0; i < bodies.size(); ++i) per_model_body[size_t(bodies[i].model_index)] = stiffness[i];
+    ModelBuilder mb(base.options());
+    for (const Model::Body& b : base.bodies()) mb.add_body({b.name, b.avatar, b.bones_dynamic});
+    for (const Model::BoundTerm& t : base.terms()) {
+      const double scale = per_model_body[size_t(t.bodies[0])];
+      const bool soft = dynamic_cast<const ElasticTerm*>(t.term.get()) || dynamic_cast<const DampingTerm*>(t.term.get());
+      mb.add_term(soft && scale != 1.0 ? std::make_shared<const ScaledTerm>(t.term, scale) : t.term, t.bodies);
+    }
+    model = mb.build();
+  }
+  const State keep = sim->scene_state();
+  *sim = Simulator(model);  // the same Simulator object: references to it stay valid
+  sim->set_state(keep);
 }
 
 SceneSession::SceneSession(const SceneDescription& scene, const SceneSessionOptions& options)
@@ -457,6 +537,42 @@ long SceneSession::steps_done() const { return impl_->k; }
 double SceneSession::seconds() const { return impl_->seconds; }
 long SceneSession::total_steps() const { return impl_->steps; }
 const StepReport& SceneSession::last_report() const { return impl_->report; }
+
+void SceneSession::reset() {
+  Impl& m = *impl_;
+  m.k = 0;
+  m.report = StepReport{};
+  m.events.clear();
+  m.in = StepInputs{};
+  m.in.bodies.resize(m.sim->model().bodies().size());
+  for (SceneTool& t : m.tools) {
+    t.grasps = t.grasps_at_start;
+    t.live = false;
+    t.pushed = PoseSample{};
+    t.link_seen = false;
+    t.link_sequence = 0;
+    t.state = SceneToolState{};
+    t.recorded = PoseSample{};
+    t.recorder.reset();  // drops the rows so far (before start_tools opens the file again)
+  }
+  State s = m.initial;
+  m.start_tools(s);
+  m.sim->set_state(s);  // a copy: fresh term caches, as in a new session
+}
+
+void SceneSession::set_stiffness_scale(double scale, int body) {
+  Impl& m = *impl_;
+  require(std::isfinite(scale) && scale > 0, "stiffness scale ", scale, ": expected a finite value > 0");
+  require(body >= -1 && body < int(m.bodies.size()), "stiffness scale: body ", body, ", expected -1 (all) or 0..",
+          int(m.bodies.size()) - 1);
+  if (body < 0)
+    std::fill(m.stiffness.begin(), m.stiffness.end(), scale);
+  else
+    m.stiffness[size_t(body)] = scale;
+  m.apply_stiffness();
+}
+
+double SceneSession::stiffness_scale(int body) const { return impl_->stiffness.at(size_t(body)); }
 const Simulator& SceneSession::simulator() const { return *impl_->sim; }
 const std::vector<SceneToolEvent>& SceneSession::tool_events() const { return impl_->events; }
 

@@ -41,6 +41,7 @@ std::string info_json(const ViewerFrame& f, const FrameEnvelope& e) {
   for (size_t i = 0; i < s.term_names.size() && i < s.term_ms.size(); ++i) terms.push_back({s.term_names[i], s.term_ms[i]});
   j["terms"] = terms;
   j["stiffness"] = s.stiffness_scale;
+  j["resets"] = s.resets;
   j["steps"] = s.steps;
   j["max_u_mm"] = s.max_displacement * 1e3;
   j["frame"] = s.frame_index;

@@ -108,6 +108,7 @@ std::string scene_json(const ViewerScene& s) {
   j["legend_max_mm"] = s.legend_max * 1e3;
   j["duration"] = s.duration;
   j["dt"] = s.dt;
+  j["can_reset"] = s.can_reset;
   return j.dump();
 }
 

@@ -314,6 +314,9 @@ void ViewerServer::Impl::on_control(int client, const std::string& text) {
     }
     m.pose = filter.last_good()->sample;
   }
+  // After a reset the tool starts over at its start pose: the page's next
+  // poses start from there, a new device session for the jump checks.
+  if (m.type == ControlType::kReset && scene.can_reset) filter = teleop::PoseStreamFilter(options.checks);
   m.client = client;
   ++accepted;
   std::lock_guard<std::mutex> lock(control_mutex);

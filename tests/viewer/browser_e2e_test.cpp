@@ -3,7 +3,10 @@
 // avatar with a probe; the page shows frames; a Shift-drag pushes the probe
 // 20 mm down (5 mm into the box); the server's own summary (printed at exit) must
 // report tool contact and a soft displacement that grew; the rendered image
-// is not blank. And `sflsh view` plays a result file: the time advances.
+// is not blank; then the panel's controls: the stiffness slider reaches the
+// server, pause holds, step takes one solver step, reset goes back to t = 0
+// (tool at its start, no displacement). And `sflsh view` plays a result
+// file: the time advances.
 // Skips with a message when chromium, node or apps/viewer/node_modules is
 // absent (scripts/setup.sh installs them).
 #include <gtest/gtest.h>
@@ -11,10 +14,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
+
+#include <nlohmann/json.hpp>
 
 #include "scene/box_avatar_fixture.hpp"
 #include "sflsh/viewer/web_assets.hpp"
@@ -102,6 +108,20 @@ std::string e2e(const std::string& url, const std::string& args) {
   return out;
 }
 
+/// The last line of `text` that parses as a JSON object (e2e.mjs prints one).
+nlohmann::json last_json_line(const std::string& text) {
+  nlohmann::json found;
+  size_t begin = 0;
+  while (begin < text.size()) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    const nlohmann::json j = nlohmann::json::parse(text.substr(begin, end - begin), nullptr, false);
+    if (j.is_object()) found = j;
+    begin = end + 1;
+  }
+  return found;
+}
+
 double number_after(const std::string& text, const std::string& key) {
   const auto at = text.find(key);
   return at == std::string::npos ? -1 : std::atof(text.c_str() + at + key.size());
@@ -117,7 +137,7 @@ TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
   const std::string url = server.wait_for(std::regex("serving (http://[^ ]+)"));
   ASSERT_FALSE(url.empty()) << server.stop();
   const std::string png = (dir_ / "live.png").string();
-  const std::string out = e2e(url, "--mode live --drag 0,-0.02,0 --seconds 2 --screenshot " + png);
+  const std::string out = e2e(url, "--mode live --drag 0,-0.02,0 --seconds 2 --controls 1 --screenshot " + png);
   const std::string summary = server.stop();
   std::printf("%s\n%s", out.c_str(), summary.c_str());
   EXPECT_NE(out.find("\"ok\":true"), std::string::npos) << out;
@@ -127,6 +147,22 @@ TEST_F(BrowserE2E, DraggingTheProbeIntoTheFleshMakesContactAndDisplacement) {
   EXPECT_GT(number_after(summary, "max |u| "), 1.0) << summary;
   EXPECT_GT(number_after(out, "\"max_u_mm_after\":"), number_after(out, "\"max_u_mm_before\":") + 1.0) << out;
   EXPECT_GT(fs::file_size(png), 10000u);
+  // The controls, as the frames reported them.
+  const nlohmann::json r = last_json_line(out);
+  ASSERT_TRUE(r.contains("controls")) << out;
+  const nlohmann::json& c = r["controls"];
+  EXPECT_NEAR(c.value("stiffness", 0.0), std::sqrt(10.0), 1e-9);  // the slider at 0.5 (log10 scale)
+  EXPECT_EQ(c.value("paused", false), true);
+  EXPECT_EQ(c.value("held", false), true);
+  EXPECT_EQ(c.value("step_count", 0), 1);
+  EXPECT_NEAR(c.value("step_dt", 0.0), 1.0 / 250, 1e-9);
+  EXPECT_EQ(c.value("resets", 0), 1);
+  EXPECT_EQ(c.value("reset_t", -1.0), 0.0);
+  EXPECT_EQ(c.value("reset_max_u_mm", -1.0), 0.0);
+  ASSERT_EQ(c["reset_device"].size(), 3u);
+  EXPECT_NEAR(double(c["reset_device"][1]), 0.045, 1e-9);  // the keyframe start, not the dragged pose
+  EXPECT_NEAR(c.value("reset_stiffness", 0.0), std::sqrt(10.0), 1e-9);
+  EXPECT_GT(c.value("resumed_t", 0.0), 0.0);
 }
 
 TEST_F(BrowserE2E, ViewPlaysAResultFile) {

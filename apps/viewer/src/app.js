@@ -14,7 +14,9 @@ const PARENTS = [-1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 1
 
 // What tests and measurements read (window.sflshViewer).
 const stats = { frames: 0, rendered: 0, bytes: 0, latencies: [], lastInfo: null, scene: null, errors: [],
-                renderedFrame: -1, fps: 0, receivedFps: 0, bandwidth: 0, maxU: 0, contactFrames: 0 };
+                renderedFrame: -1, fps: 0, receivedFps: 0, bandwidth: 0, maxU: 0, contactFrames: 0,
+                // Page time (ms, summed) per stage: decoding frames, applying them (colours, panels), normals, draws.
+                timing: { decode_ms: 0, apply_ms: 0, normals_ms: 0, render_ms: 0, draws: 0 } };
 window.sflshViewer = stats;
 // Page pixel (client coordinates) of world point p (m): for tests that aim the mouse at the tool.
 stats.project = (p) => {
@@ -23,6 +25,7 @@ stats.project = (p) => {
 };
 // Luminance statistics of the last rendered image: { mean, std, nonBackground } (fraction of pixels).
 stats.pixelStats = () => {
+  renderer.render(scene3, camera);
   const c = renderer.domElement, w = c.width, h = c.height;
   const tmp = document.createElement('canvas');
   tmp.width = w; tmp.height = h;
@@ -42,8 +45,10 @@ stats.pixelStats = () => {
 const view = $('view');
 // ?aa=0 turns antialiasing off (software renderers such as headless chromium's SwiftShader draw much faster).
 const params = new URLSearchParams(location.search);
-const renderer = new THREE.WebGLRenderer({ antialias: params.get('aa') !== '0', preserveDrawingBuffer: true });
-renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+// (No preserveDrawingBuffer: pixelStats renders and reads back in the same task.)
+const renderer = new THREE.WebGLRenderer({ antialias: params.get('aa') !== '0' });
+// ?res=R draws at R device pixels per CSS pixel (e.g. 0.5: a quarter of the fragments, for software renderers).
+renderer.setPixelRatio(Number(params.get('res')) > 0 ? Math.min(Number(params.get('res')), 2) : Math.min(window.devicePixelRatio, 2));
 view.appendChild(renderer.domElement);
 const scene3 = new THREE.Scene();
 scene3.background = new THREE.Color(0x20232a);
@@ -56,9 +61,11 @@ sun.position.set(2, 4, 3);
 scene3.add(sun);
 
 let ws = null, meta = null, skin = null, state = null, skeleton = null, dirty = false;
+let faces = null, skinDirty = false;  // skinDirty: positions changed since the last draw (normals due)
 const objects = [];
 let toolInput = null, plot = null, arrow = null, driver = false, paused = false;
 let seq = 0;
+let lastResets = 0, stiffnessSentAt = -1e9;
 const sentAt = new Map();  // seq -> performance.now() at send, for input-to-photon
 let pendingLatency = [];    // send times of the tool poses the latest frames answer, timed at their render
 
@@ -93,9 +100,16 @@ function buildScene(m) {
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(state.pos, 3));
   g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * V), 3));
-  g.setIndex(m.faces);
-  g.computeVertexNormals();
-  skin = new THREE.Mesh(g, new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.7, side: THREE.DoubleSide }));
+  g.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(3 * V), 3));
+  for (const name of ['position', 'color', 'normal']) g.attributes[name].setUsage(THREE.DynamicDrawUsage);
+  faces = Uint32Array.from(m.faces);
+  g.setIndex(new THREE.BufferAttribute(faces, 1));
+  updateNormals(g);
+  // ?mat=standard: three's PBR material (slower in software renderers); default Lambert.
+  const material = params.get('mat') === 'standard'
+    ? new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.7, side: THREE.DoubleSide })
+    : new THREE.MeshLambertMaterial({ vertexColors: true, side: THREE.DoubleSide });
+  skin = new THREE.Mesh(g, material);
   scene3.add(skin);
   recolor();
   for (const o of m.objects) {
@@ -130,6 +144,8 @@ function buildScene(m) {
   $('livebox').classList.toggle('hidden', !live);
   $('playbox').classList.toggle('hidden', live);
   $('timeline').max = String(m.duration);
+  $('reset').disabled = live && m.can_reset === false;
+  if ($('reset').disabled) $('reset').title = 'this run writes files along its time line (--out, --tool-log): no reset';
   if (live && m.tools.length > 0) {
     $('toolbox').classList.remove('hidden');
     $('toolname').textContent = m.tools[0].name;
@@ -143,18 +159,44 @@ function buildScene(m) {
   dirty = true;
 }
 
+// The colour map sampled at the 256 levels |u| is sent with (8 bits of the legend's range).
+const LUT = new Float32Array(3 * 256);
+for (let k = 0; k < 256; ++k) LUT.set(colormap(k / 255), 3 * k);
 function recolor(changed) {
-  const col = skin.geometry.attributes.color.array, max = meta.legend_max_mm / 1e3;
-  const paint = (i) => { const [r, g, b] = colormap(state.mag[i] / max); col[3 * i] = r; col[3 * i + 1] = g; col[3 * i + 2] = b; };
-  if (changed) for (const i of changed) paint(i);
-  else for (let i = 0; i < state.mag.length; ++i) paint(i);
+  const col = skin.geometry.attributes.color.array, mag = state.mag, scale = 255e3 / meta.legend_max_mm;
+  const paint = (i) => {
+    const k = 3 * Math.min(255, Math.round(mag[i] * scale));
+    col[3 * i] = LUT[k]; col[3 * i + 1] = LUT[k + 1]; col[3 * i + 2] = LUT[k + 2];
+  };
+  if (changed) for (let e = 0; e < changed.length; ++e) paint(changed[e]);
+  else for (let i = 0; i < mag.length; ++i) paint(i);
   skin.geometry.attributes.color.needsUpdate = true;
+}
+
+// Area-weighted vertex normals of the skin (what three's computeVertexNormals
+// gives, without its per-face Vector3 work): one pass over the faces.
+function updateNormals(geometry) {
+  const p = geometry.attributes.position.array, out = geometry.attributes.normal.array;
+  out.fill(0);
+  for (let f = 0; f < faces.length; f += 3) {
+    const a = 3 * faces[f], b = 3 * faces[f + 1], c = 3 * faces[f + 2];
+    const ux = p[b] - p[a], uy = p[b + 1] - p[a + 1], uz = p[b + 2] - p[a + 2];
+    const vx = p[c] - p[a], vy = p[c + 1] - p[a + 1], vz = p[c + 2] - p[a + 2];
+    const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+    out[a] += nx; out[a + 1] += ny; out[a + 2] += nz;
+    out[b] += nx; out[b + 1] += ny; out[b + 2] += nz;
+    out[c] += nx; out[c + 1] += ny; out[c + 2] += nz;
+  }
+  for (let i = 0; i < out.length; i += 3) {
+    const l = Math.hypot(out[i], out[i + 1], out[i + 2]) || 1;
+    out[i] /= l; out[i + 1] /= l; out[i + 2] /= l;
+  }
+  geometry.attributes.normal.needsUpdate = true;
 }
 
 const tmpQ = new THREE.Quaternion(), tmpP = new THREE.Vector3(), one = new THREE.Vector3(1, 1, 1);
 function applyFrame(f) {
-  skin.geometry.attributes.position.needsUpdate = true;
-  skin.geometry.computeVertexNormals();
+  skinDirty = true;  // positions and normals are uploaded once per drawn frame (loop)
   recolor(f.changed);
   for (let o = 0; o < objects.length && 7 * o < f.poses.length; ++o) {
     const p = f.poses.subarray(7 * o, 7 * o + 7);
@@ -179,13 +221,48 @@ function applyFrame(f) {
   if (info.tool && info.tool.contact) ++stats.contactFrames;
   driver = info.driver;
   paused = info.paused;
+  // A reset moved the tool back to its start: take the server's pose again.
+  if (info.resets !== undefined && info.resets !== lastResets) {
+    lastResets = info.resets;
+    if (toolInput) toolInput.resync();
+  }
+  if (meta.mode === 'live' && document.activeElement !== $('stiffness') && performance.now() - stiffnessSentAt > 1000) {
+    $('stiffness').value = String(Math.log10(info.stiffness));
+    $('stiffval').textContent = info.stiffness.toFixed(2);
+  }
   showInfo(info);
   // Controls this frame answers: timed when it reaches the screen.
   for (const [s, t0] of sentAt) if (s <= info.seq) { pendingLatency.push(t0); sentAt.delete(s); }
   dirty = true;
 }
 
+// Every frame: what the 3-D view shows (force arrow, the tool's pose), the
+// plot's samples. The DOM panels at most 5 times a second (text and table
+// updates cost style, layout and paint of the side panel).
+let panelsAt = -1e9;
 function showInfo(info) {
+  if (info.tool) {
+    const F = new THREE.Vector3(...info.tool.force), n = F.length();
+    if (plot) plot.push(info.t, info.tool.force);
+    if (toolInput) toolInput.serverPose(info.tool, driver);
+    if (arrow) {
+      arrow.visible = n > 1e-6;
+      if (arrow.visible) {
+        const to = objects[meta.tools[0].object];
+        arrow.position.setFromMatrixPosition(to ? to.matrix : new THREE.Matrix4().makeTranslation(...info.tool.device));
+        arrow.setDirection(F.clone().normalize());
+        const len = Math.min(0.02 * n, 0.5);
+        arrow.setLength(len, Math.min(0.3 * len, 0.05), Math.min(0.15 * len, 0.025));
+      }
+    }
+  }
+  const now = performance.now();
+  if (now - panelsAt < 200) return;
+  panelsAt = now;
+  showPanels(info);
+}
+
+function showPanels(info) {
   const live = meta.mode === 'live';
   $('status').textContent = `${live ? 'live' : 'playback'} · t = ${info.t.toFixed(3)} s` +
     (info.paused ? ' · paused' : '') + (live ? (info.driver ? ' · you drive' : ' · watching') : '') +
@@ -210,21 +287,10 @@ function showInfo(info) {
     b.innerHTML = `<div class="bar" style="width:${(100 * ms / total).toFixed(0)}%"></div>`;
   }
   if (info.tool) {
-    const F = new THREE.Vector3(...info.tool.force), n = F.length();
+    const n = Math.hypot(...info.tool.force);
     $('force').textContent = `${n.toFixed(2)} (${info.tool.force.map((x) => x.toFixed(2)).join(', ')})`;
     $('contact').textContent = info.tool.contact ? '· contact' : '';
-    if (plot) plot.push(info.t, info.tool.force);
-    if (toolInput) toolInput.serverPose(info.tool, driver);
-    if (arrow) {
-      arrow.visible = n > 1e-6;
-      if (arrow.visible) {
-        const to = objects[meta.tools[0].object];
-        arrow.position.setFromMatrixPosition(to ? to.matrix : new THREE.Matrix4().makeTranslation(...info.tool.device));
-        arrow.setDirection(F.clone().normalize());
-        const len = Math.min(0.02 * n, 0.5);
-        arrow.setLength(len, Math.min(0.3 * len, 0.05), Math.min(0.15 * len, 0.025));
-      }
-    }
+    if (plot) plot.draw();
   }
 }
 
@@ -240,10 +306,14 @@ function connect() {
       }
       if (!meta) return;
       stats.bytes += ev.data.byteLength;
+      const t0 = performance.now();
       const f = decodeFrame(ev.data, meta, state);
       stats.frames++;
       stats.lastFrameNumber = f.number;
+      const t1 = performance.now();
       applyFrame(f);
+      stats.timing.decode_ms += t1 - t0;
+      stats.timing.apply_ms += performance.now() - t1;
     } catch (e) {
       stats.errors.push(String(e));
       console.error(e);
@@ -255,6 +325,19 @@ function connect() {
 // Panels' controls.
 $('pause').onclick = () => send({ type: 'pause', paused: !paused });
 $('step').onclick = () => send({ type: 'step' });
+$('reset').onclick = () => { if (send({ type: 'reset' }) && toolInput && driver) toolInput.hold(); };
+// The stiffness slider is logarithmic: 10^value, 0.1 to 10 (control_message.hpp's range);
+// sent at most every 100 ms while dragged (each one rebuilds the model's elastic terms), and on release.
+function sendStiffness(force) {
+  const k = Math.min(Math.max(Math.pow(10, Number($('stiffness').value)), 0.1), 10);
+  $('stiffval').textContent = k.toFixed(2);
+  const now = performance.now();
+  if (!force && now - stiffnessSentAt < 100) return;
+  stiffnessSentAt = now;
+  send({ type: 'stiffness', scale: k });
+}
+$('stiffness').oninput = () => sendStiffness(false);
+$('stiffness').onchange = () => sendStiffness(true);
 $('play').onclick = () => send({ type: 'pause', paused: !paused });
 $('pstep').onclick = () => send({ type: 'step' });
 $('speed').onchange = () => send({ type: 'speed', speed: Number($('speed').value) });
@@ -272,12 +355,24 @@ function loop(now) {
   requestAnimationFrame(loop);
   if (toolInput) toolInput.tick(now);
   if (dirty) {
+    const t0 = performance.now();
+    if (skinDirty) {
+      updateNormals(skin.geometry);
+      skin.geometry.attributes.position.needsUpdate = true;
+      skinDirty = false;
+    }
+    const t1 = performance.now();
     renderer.render(scene3, camera);
+    const t2 = performance.now();
+    stats.timing.normals_ms += t1 - t0;
+    stats.timing.render_ms += t2 - t1;
+    stats.timing.draws++;
     dirty = false;
     ++stats.rendered;
     stats.renderedFrame = stats.lastFrameNumber ?? -1;
     ++fpsCount;
-    for (const t0 of pendingLatency) stats.latencies.push(now - t0);
+    // Input to photon: from the pose's send to the end of the draw that shows its answer.
+    for (const ts of pendingLatency) stats.latencies.push(t2 - ts);
     pendingLatency = [];
   }
   if (now - fpsT0 >= 1000) {

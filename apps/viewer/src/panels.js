@@ -19,14 +19,14 @@ export function drawLegend(canvas, maxMm, midEl, maxEl) {
   maxEl.textContent = `≥ ${maxMm.toFixed(1)}`;
 }
 
-// Force on the tool over the last `span` seconds: |F| and its x, y, z components (N).
+// Force on the tool over the last `span` seconds: |F| and its x, y, z components (N);
+// push() adds a sample, draw() paints.
 export class ForcePlot {
   constructor(canvas, span) { this.canvas = canvas; this.span = span; this.samples = []; }
   push(t, f) {
     if (this.samples.length && t < this.samples[this.samples.length - 1][0]) this.samples = [];  // reset
     this.samples.push([t, f[0], f[1], f[2], Math.hypot(f[0], f[1], f[2])]);
     while (this.samples.length && this.samples[0][0] < t - this.span) this.samples.shift();
-    this.draw();
   }
   draw() {
     const c = this.canvas, ctx = c.getContext('2d'), s = this.samples;

@@ -23,8 +23,9 @@ export function decodeFrame(buf, scene, state) {
   if (kind === DELTA && !state.ready) throw new Error('delta frame before a full frame');
   let at = 48;
   let index = null;
-  if (kind === DELTA) { index = new Uint32Array(buf.slice(at, at + 4 * N)); at += 4 * N; }
-  const q = new Uint16Array(buf.slice(at, at + 6 * N)); at += 6 * N;
+  // Views, not copies: every section starts aligned to its element size (header 48 bytes, padding to 4).
+  if (kind === DELTA) { index = new Uint32Array(buf, at, N); at += 4 * N; }
+  const q = new Uint16Array(buf, at, 3 * N); at += 6 * N;
   const m = new Uint8Array(buf, at, N); at += N;
   at = (at + 3) & ~3;
   const lo = scene.box_min, hi = scene.box_max;
@@ -38,8 +39,9 @@ export function decodeFrame(buf, scene, state) {
     state.mag[i] = m[e] * um;
   }
   state.ready = true;
-  const poses = new Float32Array(buf.slice(at, at + 28 * O)); at += 28 * O;
-  const joints = new Float32Array(buf.slice(at, at + 12 * J)); at += 12 * J;
+  if (at + 28 * O + 12 * J + L > buf.byteLength) throw new Error('truncated frame');
+  const poses = new Float32Array(buf, at, 7 * O); at += 28 * O;
+  const joints = new Float32Array(buf, at, 3 * J); at += 12 * J;
   const info = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, at, L)));
   return { kind, number, time, changed: index, poses, joints, info, bytes: buf.byteLength };
 }

@@ -73,9 +73,15 @@ export class ToolInput {
     else if (k === 'g') this.closureTarget = this.closureTarget > 0 ? 0 : Math.max(this.open, 0.5);
   }
 
+  // A reset was sent: stop sending until the server's frames show it (resync).
+  hold() { this.held = true; this.pos = this.target = null; this.dragging = false; }
+  // The server reset the scene: start again from its tool pose.
+  resync() { this.held = false; this.pos = this.target = null; this.dragging = false; }
+
   // The server's view of the tool (frame info): the starting pose, and the pose to follow while watching.
   serverPose(tool, driver) {
     this.driver = driver;
+    if (this.held) return;
     if (!this.pos || (!driver && !this.dragging)) {
       this.pos = new THREE.Vector3(...tool.device);
       this.target = this.pos.clone();

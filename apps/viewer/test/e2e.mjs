@@ -3,8 +3,11 @@
 // scripts/viewer_figures.sh:
 //   node apps/viewer/test/e2e.mjs --url http://127.0.0.1:PORT/ --mode live|playback
 //        [--screenshot out.png] [--seconds S] [--drag DX,DY,DZ] [--wheel N] [--query ?aa=0]
+//        [--controls 1] [--gl swiftshader|angle-swiftshader|in-process|egl]
 // live: waits for frames, Shift-drags the tool by DX,DY,DZ metres (default 0,-0.03,0)
 // in the view plane, holds, and reports what the server sent (contact, max |u|);
+// with --controls, then moves the stiffness slider to 10^0.5 ≈ 3.16×, pauses, steps, resets
+// and resumes with the page's controls and reports what the frames said;
 // playback: presses play and checks the time advances. Always: display fps,
 // bandwidth, input-to-photon latencies, pixel statistics of the rendered image.
 // Prints one JSON line; exits 1 when the page shows no frames or is blank.
@@ -20,16 +23,66 @@ const drag = (args.drag || '0,-0.03,0').split(',').map(Number);
 const wheel = Number(args.wheel || 0);  // Shift+wheel notches toward the scene after the drag (4 mm each)
 const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const waitInfo = (page, fn, arg) =>
+  page.waitForFunction(fn, { timeout: 10000 }, arg).then(() => true, () => false);
+
+// The live panel's controls, as a user clicks them; what the frames report after each.
+async function controls(page, info) {
+  const c = {};
+  await page.evaluate(() => {
+    const s = document.getElementById('stiffness');
+    s.value = '0.5';  // 10^0.5 = 3.16×
+    s.dispatchEvent(new Event('change'));
+  });
+  await waitInfo(page, () => Math.abs(window.sflshViewer.lastInfo.stiffness - Math.sqrt(10)) < 1e-9);
+  c.stiffness = (await info()).stiffness;
+  await page.click('#pause');
+  c.paused = await waitInfo(page, () => window.sflshViewer.lastInfo.paused);
+  await sleep(300);
+  const p0 = await info();
+  await sleep(500);
+  const p1 = await info();
+  c.held = p1.t === p0.t && p1.steps === p0.steps;
+  await page.click('#step');
+  await waitInfo(page, (n) => window.sflshViewer.lastInfo.steps > n, p1.steps);
+  await sleep(300);
+  const p2 = await info();
+  Object.assign(c, { step_count: p2.steps - p1.steps, step_dt: p2.t - p1.t });
+  await page.click('#reset');
+  await waitInfo(page, () => window.sflshViewer.lastInfo.resets >= 1);
+  await sleep(300);
+  const r = await info();
+  Object.assign(c, { resets: r.resets, reset_t: r.t, reset_max_u_mm: r.max_u_mm, reset_device: r.tool.device,
+                     reset_stiffness: r.stiffness });
+  await page.click('#pause');
+  await waitInfo(page, () => !window.sflshViewer.lastInfo.paused);
+  await sleep(500);
+  c.resumed_t = (await info()).t;
+  return c;
+}
+
 const fail = (msg, extra = {}) => { console.log(JSON.stringify({ ok: false, error: msg, ...extra })); process.exit(1); };
 
 const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'sflsh-chromium-'));
+// GPU-less WebGL back ends of chromium to compare (scripts/viewer_figures.sh):
+//   swiftshader (default): --disable-gpu, WebGL on SwiftShader through ANGLE in the GPU process;
+//   angle-swiftshader: --use-gl=angle --use-angle=swiftshader, GPU not disabled;
+//   in-process: the same as swiftshader with the GPU thread in the browser process (no GPU-process IPC);
+//   egl: --use-gl=egl (Mesa's llvmpipe when present).
+const GL = {
+  swiftshader: ['--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader'],
+  'angle-swiftshader': ['--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  'in-process': ['--disable-gpu', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--in-process-gpu'],
+  egl: ['--use-gl=egl', '--ignore-gpu-blocklist'],
+};
+const gl = args.gl || 'swiftshader';
+if (!GL[gl]) { console.log(JSON.stringify({ ok: false, error: `--gl ${gl}: expected one of ${Object.keys(GL)}` })); process.exit(1); }
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true, userDataDir,
-  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-         '--disable-component-update', '--disable-sync', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
-         '--window-size=1280,800'],
+  args: ['--no-sandbox', '--disable-quic', '--no-first-run', '--disable-background-networking',
+         '--disable-component-update', '--disable-sync', ...GL[gl], '--window-size=1280,800'],
 });
-const result = { ok: true, mode };
+const result = { ok: true, mode, gl };
 try {
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 800 });
@@ -63,11 +116,18 @@ try {
     }
     await page.keyboard.up('Shift');
     // Hold; the page accumulates what every frame from the server said (contact, max |u|).
+    const counts = () => page.evaluate(() => [performance.now(), window.sflshViewer.rendered, window.sflshViewer.frames,
+                                              window.sflshViewer.bytes]);
+    const h0 = await counts();
     await sleep(seconds * 1000);
+    const h1 = await counts(), dt = (h1[0] - h0[0]) / 1000;
+    result.hold = { seconds: +dt.toFixed(2), drawn_fps: +((h1[1] - h0[1]) / dt).toFixed(2),
+                    received_fps: +((h1[2] - h0[2]) / dt).toFixed(2), mb_per_s: +((h1[3] - h0[3]) / dt / 1e6).toFixed(4) };
     const last = await info();
     const seen = await page.evaluate(() => [window.sflshViewer.contactFrames, window.sflshViewer.maxU]);
     Object.assign(result, { contact: seen[0] > 0, contact_frames: seen[0], max_u_mm_after: seen[1], device_before: from, device_after: last.tool.device,
                             force_after: last.tool.force, rtf: last.rtf, step_ms: last.step_ms, driver: last.driver });
+    if (args.controls) result.controls = await controls(page, info);
   } else {
     await page.click('#play');
     await sleep(seconds * 1000);
@@ -76,8 +136,15 @@ try {
   }
   const s = await page.evaluate(() => {
     const v = window.sflshViewer, l = v.latencies.slice().sort((a, b) => a - b);
+    const t = v.timing, per = (x, n) => (n ? +(x / n).toFixed(3) : null);
     return { fps: v.fps, received_fps: v.receivedFps, bandwidth: v.bandwidth, frames: v.frames, rendered: v.rendered, errors: v.errors,
-             latency_median_ms: l.length ? l[l.length >> 1] : null, latency_count: l.length, pixels: v.pixelStats() };
+             latency_median_ms: l.length ? l[l.length >> 1] : null, latency_count: l.length,
+             page_ms: { decode_per_frame: per(t.decode_ms, v.frames), apply_per_frame: per(t.apply_ms, v.frames),
+                        normals_per_draw: per(t.normals_ms, t.draws), render_call_per_draw: per(t.render_ms, t.draws) },
+             renderer: (() => { const g = document.createElement('canvas').getContext('webgl2');
+                                const d = g && g.getExtension('WEBGL_debug_renderer_info');
+                                return d ? g.getParameter(d.UNMASKED_RENDERER_WEBGL) : null; })(),
+             pixels: v.pixelStats() };
   });
   Object.assign(result, s, { consoleErrors });
   if (args.screenshot) await page.screenshot({ path: args.screenshot });

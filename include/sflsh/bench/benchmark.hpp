@@ -2,7 +2,8 @@
 // `sflsh bench`: run time against error. On one avatar shape and one motion
 // (bones prescribed, soft tissue dynamic) it runs the full-FEM reference
 // (Newton to convergence, CHOLMOD), the reduced solver at several handle counts,
-// time steps and Newton iteration counts, and skinning only (u = 0), and
+// time steps and Newton iteration counts, the Bullet 3 peer (bullet_peer.hpp;
+// stopped at its first inverted tetra) and skinning only (u = 0), and
 // compares the soft displacement of the skin in the simulated region at common
 // frame times (30 per second).
 //
@@ -24,6 +25,7 @@ namespace sflsh {
 
 struct BenchOptions {
   bool quick = false;                     ///< fewer variants, 0.5 s of motion
+  bool peer = true;                       ///< the Bullet 3 peer rows (bullet_peer.hpp)
   std::string motion = "builtin:jump";
   double seconds = 0;                     ///< 0: 0.5 s quick, 2 s full
   std::string model = "procedural";
@@ -42,7 +44,7 @@ struct RegionError {
 };
 
 struct BenchRow {
-  std::string method;  ///< reference | reduced | skinning
+  std::string method;  ///< reference | reduced | peer | skinning
   std::string label;   ///< the variant in words (table, plot legend; not in the CSV)
   int handles = 0;
   double dt = 0;

@@ -114,6 +114,27 @@ class SceneSession {
   const StepReport& advance();
   const StepReport& last_report() const;
 
+  /// Back to the scene's start (time 0, steps_done() 0): every body, dynamic
+  /// object and coupled tool in its initial state; tools follow their
+  /// keyframes / pose file again (pushed poses are dropped; a live stream's
+  /// newest sample is taken at the next step, as at the start); grasps,
+  /// events and the last report cleared; a recording (record_dir) starts over
+  /// (the rows before the reset are dropped). The stiffness scales are
+  /// settings and stay. Deterministic: reset() and N advance() calls give
+  /// bit-identical states to a fresh session's N steps (with the same scales
+  /// and pushed poses).
+  void reset();
+  /// Scales the soft-tissue stiffness of body `body` (−1: every body) by
+  /// `scale` (> 0, 1 = the avatar's material) from the next step on: every
+  /// region's Young's moduli and Fung c times `scale` (Poisson's ratio
+  /// kept), which multiplies the elastic energy density — StVK, Fung
+  /// saturation and the volume barrier — by exactly `scale`, and with it the
+  /// stiffness-proportional damping (solver.damping). The state is kept.
+  /// Throws naming the value or the body index when out of range.
+  void set_stiffness_scale(double scale, int body = -1);
+  /// The stiffness scale of body `body` (1 unless set).
+  double stiffness_scale(int body) const;
+
   // Bodies (avatars), in the scene's order.
   int num_bodies() const;
   const std::string& body_name(int body) const;
@@ -158,6 +179,8 @@ class SceneSession {
   /// `step_ms`: the mean step time since the previous frame).
   void record_frame(SimulationResult& result, double step_ms) const;
 
+  /// The simulator: the same object for the session's life (references stay
+  /// valid); set_stiffness_scale() gives it a new model (its terms rescaled).
   const Simulator& simulator() const;
 
  private:

@@ -23,7 +23,7 @@
 //          28O  poses     float32 px py pz qw qx qy qz per object (object -> world)
 //          12J  joints    float32 x y z
 //           L   info      UTF-8 JSON: {"t","seq","driver","clients","paused","rtf","step_ms",
-//                         "terms":[[name, ms]...],"stiffness","steps","max_u_mm","frame","speed",
+//                         "terms":[[name, ms]...],"stiffness","resets","steps","max_u_mm","frame","speed",
 //                         "tool":{"force":[N],"device":[m],"quat":[w,x,y,z],"closure","contact","anchors"}}
 // 16-bit positions keep a 2 m box to 0.03 mm and the default avatar (~9k
 // vertices) at 63 kB per full frame (1.9 MB/s at 30 fps); deltas are smaller
@@ -51,7 +51,8 @@ struct ViewerStats {
   std::vector<std::string> term_names;  ///< per-term split of step_ms
   std::vector<double> term_ms;          ///< ms per step, same order
   bool paused = false;
-  double stiffness_scale = 1;
+  double stiffness_scale = 1;  ///< live: the soft tissue's stiffness scale (SceneSession::stiffness_scale)
+  long resets = 0;              ///< live: resets applied so far
   long steps = 0;
   bool has_tool = false;        ///< the driven tool's readout below is meaningful
   Vec3 force = Vec3::Zero();    ///< N, world: the bodies' force on the tool

@@ -2,11 +2,10 @@
 // `sflsh run scene.yaml --serve`: a SceneSession shown and driven in the
 // browser. The page's tool poses become the first tool's device poses
 // (SceneSession::set_device_pose, the same interface as the device stream of
-// issue 11); pause/step come from the page; frames go out at the display rate
-// from run_live's per-frame hook, never blocking the physics.
-//
-// Not yet applied live (the page hides them in live mode): reset and the
-// stiffness scale: SceneSession has no API to restart or rescale a material.
+// issue 11); pause, step, reset (SceneSession::reset) and the stiffness slider
+// (SceneSession::set_stiffness_scale, every body) come from the page and are
+// applied between frames; frames go out at the display rate from run_live's
+// per-frame hook, never blocking the physics.
 #include <memory>
 #include <string>
 
@@ -20,16 +19,23 @@ class LiveViewer {
  public:
   /// Builds the viewer scene from `session` (its skin, objects, tools) and
   /// starts the server (prints the URL on stdout). `session` must outlive it.
-  LiveViewer(SceneSession& session, const ViewerServerOptions& options, const std::string& title);
+  /// `allow_reset` false: reset messages are logged and ignored and the page
+  /// disables its button (a run writing files along the time line).
+  LiveViewer(SceneSession& session, const ViewerServerOptions& options, const std::string& title,
+             bool allow_reset = true);
   ~LiveViewer();
 
-  /// Sets hooks.before_frame (apply the page's controls; hold while paused)
-  /// and hooks.after_frame (publish a frame when one is due).
+  /// Sets hooks.before_frame (apply the page's controls; hold while paused),
+  /// wraps hooks.after_step (the run's own hook first; then the controls and,
+  /// when one is due, a frame: between substeps, so a real-time frame that
+  /// runs max_substeps delays neither) and sets hooks.after_frame (a frame
+  /// when due). Install after setting the run's own after_step.
   void install(LiveRunHooks& hooks);
   /// The frame of the session's current state (public for tests).
   ViewerFrame frame(const LiveRunStatus& status) const;
   /// One line: frames served, clients, bandwidth, controls applied/ignored,
-  /// the largest |u| seen (mm) and the frames with tool contact.
+  /// the largest |u| seen (mm), the frames with tool contact and the mean
+  /// time building a frame on the physics thread (ms).
   std::string summary() const;
   ViewerServer& server();
 

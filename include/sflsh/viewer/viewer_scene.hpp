@@ -35,6 +35,7 @@ struct ViewerScene {
   double legend_max = 0.02;  ///< m: colour scale top (|u| is sent as 8 bits of [0, legend_max])
   double duration = 0;       ///< s, playback: the last frame's time; live: the scene's duration
   double dt = 0;             ///< s, the solver's step
+  bool can_reset = true;     ///< live: the server applies reset messages
 };
 
 /// The scene of a result (or of SceneSession::result_header() with at least
@@ -50,7 +51,7 @@ ViewerScene viewer_scene(const SimulationResult& result, const std::vector<std::
 /// The scene as the JSON text sent on connect:
 /// {"type":"scene","mode","title","faces":[...flat],"rest":[...flat],"bodies":[{"name","begin","end"}],
 ///  "joints":J,"objects":[{"name","shape","kind","vertices":[...],"faces":[...]}],"tools":[{"name","object"}],
-///  "box_min":[3],"box_max":[3],"legend_max_mm":x,"duration":s,"dt":s,"protocol":1}
+///  "box_min":[3],"box_max":[3],"legend_max_mm":x,"duration":s,"dt":s,"can_reset":b,"protocol":1}
 std::string scene_json(const ViewerScene& scene);
 
 }  // namespace sflsh::viewer
