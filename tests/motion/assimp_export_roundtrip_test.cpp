@@ -117,13 +117,64 @@ TEST(AssimpExportRoundTrip, GltfGlbAndAsciiFbxCarryTheJointTrajectories) {
     EXPECT_EQ(report.format, "assimp");
     EXPECT_EQ(report.mapped.size(), 22u) << "the CMU map drives SMPL joints 0..21";
     expect_same_clip(src_clip, clip, fmt.id);
+  }
+}
 
-    // The CLI reads it the same way.
+// `sflsh motion info` reads the exported files the same way (a separate suite:
+// the sanitizer build has no sflsh executable, scripts/test.sh filters it out).
+TEST(AssimpExportCli, MotionInfoReadsTheExportedFiles) {
+  test::TempDir dir;
+  const std::string bvh = dir.file("source.bvh");
+  std::ofstream(bvh) << source_bvh();
+  const auto scene = test::skinned_scene(skeleton_motion_from_bvh(read_bvh(bvh)));
+  for (const Format& fmt : {Format{"glb2", ".glb"}, Format{"gltf2", ".gltf"}, Format{"fbxa", ".fbx"}}) {
+    const std::string path = dir.file("motion_" + fmt.id + fmt.extension);
+    test::export_scene(*scene, fmt.id, path);
     std::string out;
     ASSERT_EQ(test::run_command(test::sflsh_binary() + " motion info " + path + " --json", &out), 0) << out;
     EXPECT_NE(out.find("\"format\": \"assimp\""), std::string::npos) << out;
     EXPECT_NE(out.find("\"frames\": " + std::to_string(kFrames)), std::string::npos) << out;
     EXPECT_NE(out.find("\"LeftArm -> left_shoulder\""), std::string::npos) << out;
+  }
+}
+
+// A channel with fewer keys than the longest one (every other frame here):
+// the reader interpolates it at the frame times, slerp for rotations and
+// linear for positions (assimp_motion.hpp): odd frames fall midway between
+// two keys (mutant M24 in scripts/results/mutation.md took the earlier key).
+TEST(AssimpExportRoundTrip, ChannelsWithFewerKeysAreInterpolatedAtTheFrameTimes) {
+  test::TempDir dir;
+  const std::string bvh = dir.file("source.bvh");
+  std::ofstream(bvh) << source_bvh();
+  const SkeletonMotion src = skeleton_motion_from_bvh(read_bvh(bvh));
+  const auto scene = test::skinned_scene(src);
+  const int spine = src.find("LowerBack");
+  ASSERT_GE(spine, 0);
+  aiNodeAnim* ch = nullptr;
+  for (unsigned c = 0; c < scene->mAnimations[0]->mNumChannels; ++c)
+    if (std::string(scene->mAnimations[0]->mChannels[c]->mNodeName.C_Str()) == src.names[spine])
+      ch = scene->mAnimations[0]->mChannels[c];
+  ASSERT_NE(ch, nullptr);
+  // Keep the even frames' keys only (12 frames: 0, 2, ..., 10; frame 11 then holds the last key).
+  for (unsigned k = 0; 2 * k < ch->mNumRotationKeys; ++k) {
+    ch->mRotationKeys[k] = ch->mRotationKeys[2 * k];
+    ch->mPositionKeys[k] = ch->mPositionKeys[2 * k];
+  }
+  ch->mNumRotationKeys = ch->mNumPositionKeys = (ch->mNumRotationKeys + 1) / 2;
+  const std::string path = dir.file("sparse.glb");
+  test::export_scene(*scene, "glb2", path);
+  const SkeletonMotion back = read_assimp_motion(path);
+  ASSERT_EQ(back.num_frames, src.num_frames);
+  const int b = back.find(src.names[spine]);
+  ASSERT_GE(b, 0);
+  const int n = src.num_joints(), nb = back.num_joints();
+  for (int f = 1; f + 1 < src.num_frames; f += 2) {
+    const Eigen::Quaterniond mid = src.rotations[size_t(f - 1) * n + spine].slerp(0.5, src.rotations[size_t(f + 1) * n + spine]);
+    EXPECT_NEAR(back.rotations[size_t(f) * nb + b].angularDistance(mid), 0, 1e-5) << "frame " << f;
+    EXPECT_GT(back.rotations[size_t(f) * nb + b].angularDistance(src.rotations[size_t(f - 1) * n + spine]), 1e-3)
+        << "frame " << f << " must not repeat the previous key";
+    const Vec3 p = 0.5 * (src.translations[size_t(f - 1) * n + spine] + src.translations[size_t(f + 1) * n + spine]);
+    EXPECT_NEAR((back.translations[size_t(f) * nb + b] - p).norm(), 0, 1e-4) << "frame " << f;
   }
 }
 
