@@ -26,6 +26,7 @@
 #include "sflsh/teleop/pose_file.hpp"
 #include "sflsh/teleop/pose_stream_filter.hpp"
 #include "sflsh/teleop/stream_message.hpp"
+#include "sflsh/viewer/control_message.hpp"
 
 namespace sflsh::fuzz {
 namespace {
@@ -161,11 +162,44 @@ void pose_file(const std::uint8_t* data, std::size_t size) {
     });
 }
 
+void control_message(const std::uint8_t* data, std::size_t size) {
+  using viewer::ControlType;
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  const viewer::ControlParse r = viewer::parse_control_message(text);
+  // Exactly one of a message and an error sentence.
+  if (r.message.has_value() != r.error.empty()) std::abort();
+  if (!r.message) return;
+  const viewer::ControlMessage& m = *r.message;
+  if (size > viewer::kMaxControlMessageBytes || double(m.seq) >= 9007199254740992.0) std::abort();
+  auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  switch (m.type) {
+    case ControlType::kTool:
+      if (m.tool < 0 || m.tool > 1000 || !std::isfinite(m.pose.time) || !m.pose.position.allFinite() ||
+          m.pose.position.cwiseAbs().maxCoeff() > 1e4 || std::abs(m.pose.orientation.norm() - 1.0) > 1e-9 ||
+          !in(m.pose.closure, 0.0, teleop::kMaxClosure))
+        std::abort();
+      break;
+    case ControlType::kStiffness:
+      if (!in(m.value, viewer::kMinStiffnessScale, viewer::kMaxStiffnessScale)) std::abort();
+      break;
+    case ControlType::kSeek:
+      if (!in(m.value, 0.0, 1e9)) std::abort();
+      break;
+    case ControlType::kSpeed:
+      if (!in(m.value, viewer::kMinPlaybackSpeed, viewer::kMaxPlaybackSpeed)) std::abort();
+      break;
+    case ControlType::kPause:
+    case ControlType::kStep:
+    case ControlType::kReset:
+      break;
+  }
+}
+
 const std::vector<Target>& all_targets() {
   static const std::vector<Target> targets = {
       {"bvh", bvh},       {"npz", npz},           {"body_model_h5", body_model_h5}, {"avatar_h5", avatar_h5},
       {"result_h5", result_h5}, {"material", material}, {"scene_yaml", scene_yaml}, {"mesh", mesh},
-      {"stream", stream}, {"pose_file", pose_file}};
+      {"stream", stream}, {"pose_file", pose_file}, {"control_message", control_message}};
   return targets;
 }
 

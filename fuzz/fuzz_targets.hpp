@@ -42,6 +42,10 @@ void stream(const std::uint8_t* data, std::size_t size);
 /// Pose-file text as CSV and as JSON lines (parse_pose_text); what parses is
 /// written back and must read back to the same samples.
 void pose_file(const std::uint8_t* data, std::size_t size);
+/// One browser-viewer control message (viewer::parse_control_message, the
+/// WebSocket text the page sends): it never throws, gives either a message or
+/// an error sentence, and a message holds only in-range, finite values.
+void control_message(const std::uint8_t* data, std::size_t size);
 
 inline constexpr std::array<const char*, 4> kMaterialRegions = {"belly", "thigh", "upper_arm", "chest"};
 inline constexpr std::array<const char*, 6> kSceneFiles = {"avatar.h5", "pinch.csv", "soft.yaml",

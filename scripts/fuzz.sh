@@ -2,7 +2,7 @@
 # Fuzz the readers with libFuzzer + AddressSanitizer + UBSan.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default: 60 s each, every target)
 # Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5 material
-# scene_yaml mesh stream pose_file.
+# scene_yaml mesh stream pose_file control_message.
 # Needs clang and compiler-rt (Debian: clang libclang-rt-14-dev; scripts/setup.sh).
 #
 # Builds into build-fuzz/ (the reader sources, instrumented; the rest from the
@@ -21,7 +21,7 @@
 set -euo pipefail
 SECONDS_TO_RUN="${1:-60}"
 [ $# -gt 0 ] && shift
-ALL_TARGETS=(bvh npz body_model_h5 avatar_h5 result_h5 material scene_yaml mesh stream pose_file)
+ALL_TARGETS=(bvh npz body_model_h5 avatar_h5 result_h5 material scene_yaml mesh stream pose_file control_message)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL_TARGETS[@]}")
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
@@ -40,7 +40,8 @@ SOURCES=(fuzz/fuzz_targets.cpp src/core/*.cpp src/io/hdf5_file.cpp src/io/npz.cp
          src/motion/bvh.cpp src/motion/skeleton_motion.cpp src/motion/retarget.cpp src/motion/motion_clip.cpp
          src/scene/result_file.cpp src/scene/material_file.cpp src/scene/scene_description.cpp src/io/mesh_export.cpp
          src/meshing/mesh_sdf_bake.cpp src/meshing/surface_checks.cpp src/geometry/grid_sdf.cpp
-         src/teleop/stream_message.cpp src/teleop/pose_stream_filter.cpp src/teleop/pose_file.cpp)
+         src/teleop/stream_message.cpp src/teleop/pose_stream_filter.cpp src/teleop/pose_file.cpp
+         src/viewer/control_message.cpp)
 
 echo "building the fuzz targets in $OUT ..."
 OBJS=()

@@ -205,6 +205,16 @@ TEST(FuzzReplay, ValidAndMutatedProjectFiles) {
   for (const auto& sample : teleop::read_pose_file(pinch.string()))
     jsonl += teleop::format_pose_row(sample, teleop::PoseFileFormat::kJsonLines) + "\n";
   check_valid_file("pose_file", "pinch.jsonl", jsonl);
+  // Viewer control messages: one of each type, as the page sends them.
+  const std::pair<const char*, const char*> controls[] = {
+      {"tool.json", R"({"type":"tool","seq":42,"t":1.5,"tool":0,"pos":[0.1,-0.2,0.3],"quat":[0,1,0,0],"closure":0.25})"},
+      {"pause.json", R"({"type":"pause","seq":1,"paused":true})"},
+      {"step.json", R"({"type":"step","seq":2})"},
+      {"reset.json", R"({"type":"reset","seq":3})"},
+      {"stiffness.json", R"({"type":"stiffness","seq":4,"scale":2.5})"},
+      {"seek.json", R"({"type":"seek","seq":5,"time":0.75})"},
+      {"speed.json", R"({"type":"speed","seq":6,"speed":0.5})"}};
+  for (const auto& [name, text] : controls) check_valid_file("control_message", name, text);
 }
 
 TEST(FuzzReplay, AHugeDeclaredDatasetInATinyFileIsRejectedBeforeAllocating) {

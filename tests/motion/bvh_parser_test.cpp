@@ -62,6 +62,21 @@ TEST(BvhParser, ChannelOrderIsApplied) {
   EXPECT_NEAR((m.local_translation(2, 1) - Vec3(8, -5, 0)).norm(), 0, 1e-12);
 }
 
+// Position channels add to a non-zero OFFSET, on the root and on a joint with
+// its own position channels (some exporters write 6 channels per joint).
+// tiny.bvh's root offset is 0, which cannot tell "offset + value" from "value"
+// (mutant M23 in scripts/results/mutation.md).
+TEST(BvhParser, PositionChannelsAddToANonZeroOffset) {
+  const std::string text =
+      "HIERARCHY\nROOT Hips\n{\n OFFSET 1 2 3\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+      "Yrotation\n JOINT Spine\n {\n  OFFSET 0 10 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation "
+      "Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 5 0\n  }\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n"
+      "10 20 30 0 0 0 0.5 -0.25 2 0 0 0\n";
+  const BvhMotion m = parse_bvh(text, "offsets.bvh");
+  EXPECT_NEAR((m.local_translation(0, 0) - Vec3(11, 22, 33)).norm(), 0, 1e-12);
+  EXPECT_NEAR((m.local_translation(1, 0) - Vec3(0.5, 9.75, 2)).norm(), 0, 1e-12);
+}
+
 // Each malformed variant of the tiny file must throw naming the file, the
 // line and what was expected.
 struct BadCase {
