@@ -82,11 +82,33 @@ double ElasticTerm::min_det(const VecX& z) const {
   return m;
 }
 
+namespace {
+
+/// Hessian scratch: the upper triangle of the z block, and add_sample_hessian's T.
+struct ElasticCache : TermCache {
+  MatX upper;
+  std::vector<Eigen::Matrix<double, 3, 9>> T;
+};
+
+}  // namespace
+
+std::unique_ptr<TermCache> ElasticTerm::make_cache() const { return std::make_unique<ElasticCache>(); }
+
 double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   require(q.z.size() == num_reduced_, "ElasticTerm: z has ", q.z.size(), " entries, expected ", num_reduced_);
   const int z0 = ctx.layout.z_offset(), S = num_samples();
+  // Without a cache (a term evaluated on its own, EnergyTerm::evaluate) a local one.
+  ElasticCache local;
+  auto* cache = dynamic_cast<ElasticCache*>(ctx.cache);
+  ElasticCache& c = cache ? *cache : local;
+  if (hess) {
+    // Only the upper triangle is accumulated; ½ zᵀ K z's Hessian K starts it.
+    if (exact_quadratic_)
+      c.upper = K_;
+    else
+      c.upper.setZero(num_reduced_, num_reduced_);
+  }
   double E = 0;
-  std::vector<Eigen::Matrix<double, 3, 9>> T;  // reused by add_sample_hessian
   for (int k = 0; k < S; ++k) {
     const Mat3 F = deformation_gradient(k, q.z);
     Mat3 P;
@@ -107,13 +129,18 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
     E += w * psi;
     if (grad)
       for (int e = start_[k]; e < start_[k + 1]; ++e) grad->segment<3>(z0 + 3 * handle_[e]) += w * (P * d_[e]);
-    if (hess) add_sample_hessian(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], z0, *hess, T);
+    if (hess)
+      add_sample_hessian<true>(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], 0, c.upper, c.T);
   }
   if (exact_quadratic_) {
     const VecX Kz = K_ * q.z;
     E += 0.5 * q.z.dot(Kz);
     if (grad) grad->segment(z0, num_reduced_) += Kz;
-    if (hess) hess->block(z0, z0, num_reduced_, num_reduced_) += K_;
+  }
+  if (hess) {
+    auto block = hess->block(z0, z0, num_reduced_, num_reduced_);
+    block.triangularView<Eigen::Upper>() += c.upper;
+    block.triangularView<Eigen::StrictlyLower>() += c.upper.transpose();
   }
   return E;
 }

@@ -7,7 +7,9 @@
 // handles h touching the tet (Dirichlet nodes contribute nothing).
 // Depends on z only. Hessian: Σ_k c_k G_kᵀ ΠPSD(∂²Ψ/∂F²) G_k (per-sample 9x9
 // eigenvalue clamping), G_k = ∂vec(F_k)/∂z, assembled 3x3 block by block over
-// the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product).
+// the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product),
+// into the upper triangle of a 3K by 3K scratch (started at K for
+// exact_quadratic) that is added to both triangles of the Hessian at the end.
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
@@ -28,6 +30,8 @@ class ElasticTerm : public EnergyTerm {
   explicit ElasticTerm(const Avatar& avatar, bool project_psd = true, bool exact_quadratic = true);
   std::string name() const override { return "elastic"; }
   BodyBlocks blocks() const override { return BodyBlocks::Soft; }
+  /// Scratch of the Hessian assembly (kept in the State: no allocation per step).
+  std::unique_ptr<TermCache> make_cache() const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
   /// Deformation gradient of sample k for reduced DoFs z.
