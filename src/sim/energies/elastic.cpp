@@ -68,6 +68,11 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
     const Mat9 H2 = volume[t] * linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
     add_sample_hessian(H2, handle.data(), d.data(), int(handle.size()), 0, K_, T);
   }
+  const int nh = num_reduced_ / 3;
+  K_blocks_.assign(size_t(9) * nh * nh, 0.0);
+  for (int j = 0; j < nh; ++j)
+    for (int i = 0; i <= j; ++i)
+      Eigen::Map<Mat3>(K_blocks_.data() + 9 * (size_t(nh) * j + i)) = K_.block<3, 3>(3 * i, 3 * j);
 }
 
 Mat3 ElasticTerm::deformation_gradient(int k, const VecX& z) const {
@@ -84,9 +89,9 @@ double ElasticTerm::min_det(const VecX& z) const {
 
 namespace {
 
-/// Hessian scratch: the upper triangle of the z block, and add_sample_hessian's T.
+/// Hessian scratch: the z block's upper 3x3 blocks (sample_hessian.hpp), and T.
 struct ElasticCache : TermCache {
-  MatX upper;
+  std::vector<double> blocks;
   std::vector<Eigen::Matrix<double, 3, 9>> T;
 };
 
@@ -101,12 +106,13 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
   ElasticCache local;
   auto* cache = dynamic_cast<ElasticCache*>(ctx.cache);
   ElasticCache& c = cache ? *cache : local;
+  const int K = num_reduced_ / 3;
   if (hess) {
-    // Only the upper triangle is accumulated; ½ zᵀ K z's Hessian K starts it.
+    // Only the upper blocks are accumulated; ½ zᵀ K z's Hessian K starts them.
     if (exact_quadratic_)
-      c.upper = K_;
+      c.blocks = K_blocks_;
     else
-      c.upper.setZero(num_reduced_, num_reduced_);
+      c.blocks.assign(size_t(9) * K * K, 0.0);
   }
   double E = 0;
   for (int k = 0; k < S; ++k) {
@@ -130,18 +136,15 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
     if (grad)
       for (int e = start_[k]; e < start_[k + 1]; ++e) grad->segment<3>(z0 + 3 * handle_[e]) += w * (P * d_[e]);
     if (hess)
-      add_sample_hessian<true>(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], 0, c.upper, c.T);
+      add_sample_hessian_blocks(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], K,
+                                c.blocks.data(), c.T);
   }
   if (exact_quadratic_) {
     const VecX Kz = K_ * q.z;
     E += 0.5 * q.z.dot(Kz);
     if (grad) grad->segment(z0, num_reduced_) += Kz;
   }
-  if (hess) {
-    auto block = hess->block(z0, z0, num_reduced_, num_reduced_);
-    block.triangularView<Eigen::Upper>() += c.upper;
-    block.triangularView<Eigen::StrictlyLower>() += c.upper.transpose();
-  }
+  if (hess) add_hessian_blocks(c.blocks.data(), K, z0, *hess);
   return E;
 }
 

@@ -8,8 +8,8 @@
 // Depends on z only. Hessian: Σ_k c_k G_kᵀ ΠPSD(∂²Ψ/∂F²) G_k (per-sample 9x9
 // eigenvalue clamping), G_k = ∂vec(F_k)/∂z, assembled 3x3 block by block over
 // the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product),
-// into the upper triangle of a 3K by 3K scratch (started at K for
-// exact_quadratic) that is added to both triangles of the Hessian at the end.
+// into a scratch of the upper 3x3 blocks (9 contiguous doubles each; started
+// at K for exact_quadratic) that is added to both triangles of the Hessian at the end.
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
@@ -45,6 +45,7 @@ class ElasticTerm : public EnergyTerm {
   std::vector<MaterialPoint> material_;  // #S, of the sample's tet (region and frame)
   std::vector<Mat9> linear_hessian_;    // #S ∂²Ψ₂/∂F² of the sample's material
   MatX K_;                              // 3K x 3K exact linearized stiffness (exact_quadratic)
+  std::vector<double> K_blocks_;        // K_'s upper 3x3 blocks (sample_hessian.hpp layout)
   std::vector<int> start_{0}, handle_;  // CSR over samples: handles touching the tet
   std::vector<Vec3> d_;                 // per entry: ∂u/∂x̄ per unit z_h (1/m)
   int num_reduced_ = 0;
