@@ -1,5 +1,7 @@
 #include "sflsh/bench/benchmark.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -74,9 +76,12 @@ Trace run_reference(std::shared_ptr<const Avatar> avatar, const MotionClip& moti
   return tr;
 }
 
-/// Resident size now (MiB), after resetting the process's peak (VmHWM) to it
-/// (Linux /proc/self/clear_refs "5"); NaN if either is unavailable.
+/// Resident size now (MiB), after returning the heap's free pages to the
+/// system (else a run reusing them shows no growth) and resetting the
+/// process's peak (VmHWM) to it (Linux /proc/self/clear_refs "5"); NaN if
+/// either is unavailable.
 double reset_peak_rss_mib() {
+  malloc_trim(0);
   {
     std::ofstream clear("/proc/self/clear_refs");
     if (!(clear << "5")) return kNaN;
