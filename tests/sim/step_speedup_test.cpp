@@ -41,13 +41,7 @@ Configuration random_configuration(const Avatar& a, std::mt19937& rng, double z_
   return q;
 }
 
-StepContext context(const Avatar& a, bool bones_dynamic) {
-  StepContext ctx;
-  ctx.avatar = &a;
-  ctx.layout.bones_dynamic = bones_dynamic;
-  ctx.layout.num_reduced = a.num_reduced();
-  return ctx;
-}
+StepContext context(const Avatar& a, bool bones_dynamic) { return test::soft_step_context(a, bones_dynamic); }
 
 double max_abs(const MatX& m) { return m.cwiseAbs().maxCoeff(); }
 
