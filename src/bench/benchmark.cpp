@@ -1,5 +1,7 @@
 #include "sflsh/bench/benchmark.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,11 +9,13 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <string>
 
 #include "sflsh/bench/bullet_peer.hpp"
 #include "sflsh/bench/subspace_floor.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/memory.hpp"
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
@@ -31,6 +35,8 @@ constexpr double kFrameRate = 30.0;  // comparison frames per simulated second
 struct Trace {
   std::vector<Points> u;      // per frame, #V by 3 (m)
   std::vector<double> ms;     // per step
+  // Reduced runs: summed ms of the inertia and elastic terms and the solve; peak MiB added.
+  double ms_inertia = 0, ms_elastic = 0, ms_solve = 0, peak_mib = std::numeric_limits<double>::quiet_NaN();
   std::vector<Points> nodal;  // reference only: per frame, #N by 3 nodal soft displacement (m)
 };
 
@@ -72,30 +78,56 @@ Trace run_reference(std::shared_ptr<const Avatar> avatar, const MotionClip& moti
   return tr;
 }
 
+/// Resident size now (MiB), after returning the heap's free pages to the
+/// system (else a run reusing them shows no growth) and resetting the
+/// process's peak (VmHWM) to it (Linux /proc/self/clear_refs "5"); NaN if
+/// either is unavailable.
+double reset_peak_rss_mib() {
+  malloc_trim(0);
+  {
+    std::ofstream clear("/proc/self/clear_refs");
+    if (!(clear << "5")) return kNaN;
+  }
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
+  return kNaN;
+}
+
 Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
-                  int newton_iters, const std::string& label, bool mean_dilatation = true) {
+                  int newton_iters, const std::string& label, bool bones_dynamic = false,
+                  bool mean_dilatation = true) {
+  const double rss0 = reset_peak_rss_mib();
   SimulatorOptions o;
   o.mean_dilatation = mean_dilatation;
   o.h = h;
-  o.bones_dynamic = false;
+  o.bones_dynamic = bones_dynamic;
   o.newton.iterations = newton_iters;
   o.newton.line_search = newton_iters > 1;
-  Simulator sim(avatar_model(avatar, o));
+  const SkeletonTermsOptions skeleton;  // dynamic bones: the skeleton terms, as `sflsh simulate`
+  Simulator sim(avatar_model(avatar, o, bones_dynamic ? &skeleton : nullptr));
   sim.reset(target_bones(*avatar, motion.sample(0)));
   Trace tr;
   tr.u.push_back(sim.soft_displacement());
   const int per = steps_per_frame(h);
   const long steps = std::lround(seconds / h);
-  Progress p("bench: " + label, steps);
+  Progress p("bench: " + label + (bones_dynamic ? " (dynamic bones)" : ""), steps);
   for (long s = 1; s <= steps; ++s) {
     const BodyPose pose = motion.sample(s * h);
     const StepReport rep = sim.step(target_bones(*avatar, pose), pose);
     require(sim.state().z.allFinite(), "bench: ", label, " became non-finite at step ", s);
     tr.ms.push_back(rep.ms_total);
+    for (const TermEnergy& e : rep.energies) {
+      if (e.name == "inertia") tr.ms_inertia += e.ms;
+      if (e.name == "elastic") tr.ms_elastic += e.ms;
+    }
+    tr.ms_solve += rep.ms_solve;
     if (s % per == 0) tr.u.push_back(sim.soft_displacement());
     p.update(s);
   }
   p.finish();
+  tr.peak_mib = peak_rss_mib() - rss0;
   return tr;
 }
 
@@ -295,6 +327,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
       if (std::isfinite(e[size_t(g)])) r.regions.push_back({base.materials[size_t(g)].name, e[size_t(g)], fl ? ef[size_t(g)] : kNaN});
   };
   BenchRow rr{"reference", "full FEM, Newton to convergence", 0, h, -1, false};
+  rr.ms_inertia = rr.ms_elastic = rr.ms_solve = rr.dynamic_ms_median = rr.peak_mib = kNaN;
   compare(ref, ref, region, rr);
   split(ref, nullptr, rr);
   rows.push_back(rr);
@@ -303,6 +336,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   auto add = [&](const Trace& tr, const std::shared_ptr<const Avatar>& a, const std::string& method, const std::string& label, int K,
                  double dt, int iters, bool is_default) {
     BenchRow r{method, label, K, dt, iters, is_default};
+    r.ms_inertia = r.ms_elastic = r.ms_solve = r.dynamic_ms_median = r.peak_mib = kNaN;
     compare(tr, ref, region, r);
     split(tr, a, r);
     r.speedup = r.ms_median > 0 ? ref_ms / r.ms_median : 0;
@@ -311,8 +345,15 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   auto reduced = [&](std::shared_ptr<const Avatar> a, int K, double dt, int iters, const std::string& what,
                      bool is_default) {
     const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
-    add(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label), a, "reduced", label, K, dt, iters,
-        is_default);
+    const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label);
+    add(tr, a, "reduced", label, K, dt, iters, is_default);
+    BenchRow& r = rows.back();
+    const double steps = double(tr.ms.size());
+    r.ms_inertia = tr.ms_inertia / steps;
+    r.ms_elastic = tr.ms_elastic / steps;
+    r.ms_solve = tr.ms_solve / steps;
+    r.peak_mib = tr.peak_mib;
+    r.dynamic_ms_median = percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true).ms, 0.5);
   };
   const int K = o.default_handles;
   // Handle counts at the default time step and cubature, one Newton step.
@@ -321,7 +362,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   // Every tet's volume change constrained on its own (before issue 13's fix of the subspace's locking).
   {
     const std::string label = "K=" + std::to_string(K) + ", volume per tet (no mean dilatation, before)";
-    add(run_reduced(default_avatar, motion, o.seconds, h, 1, "reduced " + label, false), default_avatar, "reduced",
+    add(run_reduced(default_avatar, motion, o.seconds, h, 1, "reduced " + label, false, false), default_avatar, "reduced",
         label, K, h, 1, false);
   }
   // Time steps and Newton iterations around the default.
@@ -400,7 +441,7 @@ void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path)
     // every region with reference motion; a row without one writes nan).
     const std::vector<RegionError> names = rows.empty() ? std::vector<RegionError>() : rows[0].regions;
     f << "method,handles,dt,newton_iters,is_default,ms_median,ms_p95,speedup,err_mean_mm,err_max_mm,rel_err,peak_ratio,"
-         "floor_rel_err";
+         "floor_rel_err,ms_inertia,ms_elastic,ms_solve,dynamic_ms_median,peak_mib";
     for (const auto& g : names) f << ",rel_err_" << g.name << ",floor_" << g.name;
     f << "\n";
     char buf[512];
@@ -408,6 +449,9 @@ void write_bench_csv(const std::vector<BenchRow>& rows, const std::string& path)
       std::snprintf(buf, sizeof buf, "%s,%d,%.6g,%d,%d,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g", r.method.c_str(),
                     r.handles, r.dt, r.newton_iters, r.is_default ? 1 : 0, r.ms_median, r.ms_p95, r.speedup,
                     r.err_mean_mm, r.err_max_mm, r.rel_err, r.peak_ratio, r.floor_rel_err);
+      f << buf;
+      std::snprintf(buf, sizeof buf, ",%.4g,%.4g,%.4g,%.4g,%.4g", r.ms_inertia, r.ms_elastic, r.ms_solve,
+                    r.dynamic_ms_median, r.peak_mib);
       f << buf;
       for (const auto& g : names) {
         const RegionError* e = region_named(r, g.name);
@@ -425,7 +469,8 @@ void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& 
   std::ofstream f(path + ".partial");
   if (!f) fail(path, ": cannot write");
   f << "| method | variant | K | dt (s) | Newton iters | ms/step median | p95 | speedup | err mean (mm) | err max (mm) "
-       "| rel_err | floor | peak ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "| rel_err | floor | peak ratio | inertia / elastic / solve (ms) | dynamic bones ms/step | peak MiB |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[512];
   auto num = [](double v) {
     char b[32];
@@ -435,12 +480,21 @@ void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& 
   auto bold_default = [](const BenchRow& r, const std::string& line) {
     return r.is_default ? std::string(line).replace(2, r.method.size(), "**" + r.method + "**") : line;
   };
+  auto ms3 = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return std::isfinite(v) ? std::string(b) : std::string("–");
+  };
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "| %s | %s | %d | 1/%.0f | %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3f | %s | %.3f |\n",
+    const std::string split = std::isfinite(r.ms_solve)
+                                  ? ms3(r.ms_inertia) + " / " + ms3(r.ms_elastic) + " / " + ms3(r.ms_solve)
+                                  : std::string("–");
+    std::snprintf(buf, sizeof buf,
+                  "| %s | %s | %d | 1/%.0f | %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3f | %s | %.3f | %s | %s | %s |\n",
                   r.method.c_str(), r.label.c_str(), r.handles, 1.0 / r.dt,
                   r.newton_iters < 0 ? "to convergence" : std::to_string(r.newton_iters).c_str(), r.ms_median,
                   r.ms_p95, r.speedup, r.err_mean_mm, r.err_max_mm, r.rel_err, num(r.floor_rel_err).c_str(),
-                  r.peak_ratio);
+                  r.peak_ratio, split.c_str(), ms3(r.dynamic_ms_median).c_str(), ms3(r.peak_mib).c_str());
     f << bold_default(r, buf);
   }
   // Per region: simulated rel_err / floor.

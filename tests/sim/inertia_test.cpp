@@ -30,14 +30,7 @@ Configuration random_config(const Avatar& a, std::mt19937& rng, double z_scale) 
   return q;
 }
 
-StepContext context(const Avatar& a, bool bones_dynamic) {
-  StepContext ctx;
-  ctx.avatar = &a;
-  ctx.layout.bones_dynamic = bones_dynamic;
-  ctx.layout.num_reduced = a.num_reduced();
-  ctx.h = 1.0 / 60;
-  return ctx;
-}
+StepContext context(const Avatar& a, bool bones_dynamic) { return test::soft_step_context(a, bones_dynamic); }
 
 Avatar small_avatar() {
   test::SyntheticAvatarOptions o;

@@ -192,7 +192,11 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
   for (int i = 1; i <= 10; ++i) {
     const auto target = test::synthetic_motion(*a, i * o.h, 0.03, 0.5);
     const StepReport rep = sim.step(target);
-    EXPECT_LT(rep.grad_norm_after, 1e-8 * std::max(1.0, rep.grad_norm_before)) << rep.summary();  // round-off level
+    // Round-off level: the line search stops when E (~0.5 J, resolved to ~1e-16 J)
+    // no longer decreases, at |g| ~ 1e-8 here; reassociating the Hessian's sums
+    // (issue 13's exact speed-ups) moves the last iterate by round-off and |g|
+    // from just below to just above 1e-8, hence the margin.
+    EXPECT_LT(rep.grad_norm_after, 3e-8 * std::max(1.0, rep.grad_norm_before)) << rep.summary();
     const StepReport rep1 = sim1.step(target);
     EXPECT_LT(rep1.energy_after, rep1.energy_before) << rep1.summary();  // one step decreases E
     EXPECT_EQ(rep1.iterations, 1);

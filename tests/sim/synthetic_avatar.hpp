@@ -30,6 +30,7 @@
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/sim/configuration.hpp"
+#include "sflsh/sim/energy_term.hpp"
 
 namespace sflsh::test {
 
@@ -259,6 +260,17 @@ inline std::vector<Isometry> synthetic_motion(const Avatar& a, double t, double 
       G[j] = G[p] * rotation_about(a.joints_rest.row(j).transpose(), Vec3::UnitZ(), angle);
   }
   return G;
+}
+
+/// A one-body step context for evaluating single terms of `a`: its soft block
+/// (3K) after the bone blocks when `bones_dynamic`, h = 1/60 s.
+inline StepContext soft_step_context(const Avatar& a, bool bones_dynamic) {
+  StepContext ctx;
+  ctx.avatar = &a;
+  ctx.layout.bones_dynamic = bones_dynamic;
+  ctx.layout.num_reduced = a.num_reduced();
+  ctx.h = 1.0 / 60;
+  return ctx;
 }
 
 }  // namespace sflsh::test

@@ -56,6 +56,13 @@ struct BenchRow {
   double floor_rel_err = 0;
   /// Per simulated body region, in the avatar's region order.
   std::vector<RegionError> regions;
+  /// Reduced rows (NaN for the others): mean ms per step in the inertia and
+  /// elastic terms and the Cholesky solve (prescribed bones, as ms_median);
+  /// the median step with dynamic bones (skeleton terms, `sflsh simulate`'s
+  /// default) on the same motion; and the peak memory the run added to the
+  /// process (MiB above its resident size at the start of the run, model and
+  /// state included; NaN where /proc cannot reset the peak).
+  double ms_inertia = 0, ms_elastic = 0, ms_solve = 0, dynamic_ms_median = 0, peak_mib = 0;
 };
 
 /// Runs every variant (progress on stderr) and returns one row each.

@@ -59,6 +59,11 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
   if (!exact_quadratic_) return;
   // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
   K_ = linearized_stiffness(a, material_tet_stiffness(a), mean_dilatation_);
+  const int nh = num_reduced_ / 3;
+  K_blocks_.assign(size_t(9) * nh * nh, 0.0);
+  for (int j = 0; j < nh; ++j)
+    for (int i = 0; i <= j; ++i)
+      Eigen::Map<Mat3>(K_blocks_.data() + 9 * (size_t(nh) * j + i)) = K_.block<3, 3>(3 * i, 3 * j);
 }
 
 Mat3 ElasticTerm::deformation_gradient(int k, const VecX& z) const {
@@ -73,11 +78,34 @@ double ElasticTerm::min_det(const VecX& z) const {
   return m;
 }
 
+namespace {
+
+/// Hessian scratch: the z block's upper 3x3 blocks (sample_hessian.hpp), and T.
+struct ElasticCache : TermCache {
+  std::vector<double> blocks;
+  std::vector<Eigen::Matrix<double, 3, 9>> T;
+};
+
+}  // namespace
+
+std::unique_ptr<TermCache> ElasticTerm::make_cache() const { return std::make_unique<ElasticCache>(); }
+
 double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   require(q.z.size() == num_reduced_, "ElasticTerm: z has ", q.z.size(), " entries, expected ", num_reduced_);
   const int z0 = ctx.layout.z_offset(), S = num_samples();
+  // Without a cache (a term evaluated on its own, EnergyTerm::evaluate) a local one.
+  ElasticCache local;
+  auto* cache = dynamic_cast<ElasticCache*>(ctx.cache);
+  ElasticCache& c = cache ? *cache : local;
+  const int K = num_reduced_ / 3;
+  if (hess) {
+    // Only the upper blocks are accumulated; ½ zᵀ K z's Hessian K starts them.
+    if (exact_quadratic_)
+      c.blocks = K_blocks_;
+    else
+      c.blocks.assign(size_t(9) * K * K, 0.0);
+  }
   double E = 0;
-  std::vector<Eigen::Matrix<double, 3, 9>> T;  // reused by add_sample_hessian
   for (int k = 0; k < S; ++k) {
     const Mat3 F = deformation_gradient(k, q.z);
     Mat3 P;
@@ -98,14 +126,16 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
     E += w * psi;
     if (grad)
       for (int e = start_[k]; e < start_[k + 1]; ++e) grad->segment<3>(z0 + 3 * handle_[e]) += w * (P * d_[e]);
-    if (hess) add_sample_hessian(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], z0, *hess, T);
+    if (hess)
+      add_sample_hessian_blocks(w * H, &handle_[start_[k]], &d_[start_[k]], start_[k + 1] - start_[k], K,
+                                c.blocks.data(), c.T);
   }
   if (exact_quadratic_) {
     const VecX Kz = K_ * q.z;
     E += 0.5 * q.z.dot(Kz);
     if (grad) grad->segment(z0, num_reduced_) += Kz;
-    if (hess) hess->block(z0, z0, num_reduced_, num_reduced_) += K_;
   }
+  if (hess) add_hessian_blocks(c.blocks.data(), K, z0, *hess);
   return E;
 }
 

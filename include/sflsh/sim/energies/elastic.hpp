@@ -7,7 +7,9 @@
 // handles h touching the tet (Dirichlet nodes contribute nothing).
 // Depends on z only. Hessian: Σ_k c_k G_kᵀ ΠPSD(∂²Ψ/∂F²) G_k (per-sample 9x9
 // eigenvalue clamping), G_k = ∂vec(F_k)/∂z, assembled 3x3 block by block over
-// the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product).
+// the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product),
+// into a scratch of the upper 3x3 blocks (9 contiguous doubles each; started
+// at K for exact_quadratic) that is added to both triangles of the Hessian at the end.
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
@@ -32,6 +34,8 @@ class ElasticTerm : public EnergyTerm {
                        bool mean_dilatation = true);
   std::string name() const override { return "elastic"; }
   BodyBlocks blocks() const override { return BodyBlocks::Soft; }
+  /// Scratch of the Hessian assembly (kept in the State: no allocation per step).
+  std::unique_ptr<TermCache> make_cache() const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
 
   /// Deformation gradient of sample k for reduced DoFs z.
@@ -47,6 +51,7 @@ class ElasticTerm : public EnergyTerm {
   std::vector<MaterialPoint> material_;  // #S, of the sample's tet (region and frame)
   std::vector<Mat9> linear_hessian_;    // #S ∂²Ψ₂/∂F² of the sample's material
   MatX K_;                              // 3K x 3K exact linearized stiffness (exact_quadratic)
+  std::vector<double> K_blocks_;        // K_'s upper 3x3 blocks (sample_hessian.hpp layout)
   std::vector<int> start_{0}, handle_;  // CSR over samples: handles touching the tet
   std::vector<Vec3> d_;                 // per entry: ∂u/∂x̄ per unit z_h (1/m)
   int num_reduced_ = 0;
