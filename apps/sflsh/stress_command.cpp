@@ -51,14 +51,17 @@ void run_suite_command(const SuiteArgs& a, const std::string& command_line) {
   validate_stress_suite_options(o);  // bad input fails before the avatar is read
   io::check_output_folder(a.out, "--out");
   const auto avatar = std::make_shared<const Avatar>(read_avatar(a.avatar));
-  const std::vector<StressCaseResult> results = run_stress_suite(avatar, o);
-  std::error_code ec;
-  std::filesystem::create_directories(a.out, ec);
-  if (ec) fail("--out ", a.out, ": cannot create output folder: ", ec.message());
   const std::filesystem::path dir(a.out);
-  write_stress_suite_csv(results, (dir / "stress_suite.csv").string());
-  write_stress_suite_markdown(results, (dir / "stress_suite.md").string(), command_line);
-  write_stress_suite_svg(results, (dir / "stress_suite.svg").string());
+  // The tables are rewritten after every case: a long suite stopped half-way keeps its finished cases.
+  const std::vector<StressCaseResult> results =
+      run_stress_suite(avatar, o, [&](const std::vector<StressCaseResult>& so_far) {
+        std::error_code ec;
+        std::filesystem::create_directories(a.out, ec);
+        if (ec) fail("--out ", a.out, ": cannot create output folder: ", ec.message());
+        write_stress_suite_csv(so_far, (dir / "stress_suite.csv").string());
+        write_stress_suite_markdown(so_far, (dir / "stress_suite.md").string(), command_line);
+        write_stress_suite_svg(so_far, (dir / "stress_suite.svg").string());
+      });
   int failed = 0;
   for (const StressCaseResult& r : results) {
     std::printf("%-24s %-8s steps %6ld  NaN %d  rejected %4d  damped %4d  min det %.3f  peak soft %6.1f mm", r.name.c_str(),

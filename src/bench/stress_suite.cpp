@@ -178,7 +178,8 @@ void validate_stress_suite_options(const StressSuiteOptions& o) {
   require(o.window >= 1, "--window must be >= 1, got ", o.window);
 }
 
-std::vector<StressCaseResult> run_stress_suite(std::shared_ptr<const Avatar> avatar, const StressSuiteOptions& o) {
+std::vector<StressCaseResult> run_stress_suite(std::shared_ptr<const Avatar> avatar, const StressSuiteOptions& o,
+                                               const std::function<void(const std::vector<StressCaseResult>&)>& on_case) {
   validate_stress_suite_options(o);
   const std::vector<std::string>& specs = o.cases.empty() ? stress_suite_default_cases() : o.cases;
   std::vector<StressCaseResult> out;
@@ -217,6 +218,7 @@ std::vector<StressCaseResult> run_stress_suite(std::shared_ptr<const Avatar> ava
       std::fprintf(stderr, "stress-suite: %s failed: %s\n", spec.c_str(), e.what());
       out.push_back(r);
     }
+    if (on_case) on_case(out);
   }
   return out;
 }

@@ -56,7 +56,15 @@ std::vector<double> joint_subtree_inertia(const Avatar& avatar, const std::vecto
   require(int(bodies.size()) == J && avatar.joints_rest.rows() == J, "joint_subtree_inertia: ", bodies.size(),
           " bodies for ", J, " joints");
   std::vector<Mat3> I(J, Mat3::Zero());
-  add_subtree_bodies(avatar, bodies, I);  // body i is moved by joint i and all its ancestors
+  for (int i = 0; i < J; ++i) {
+    // Body i is moved by joint i and all its ancestors. (Written out, not
+    // add_subtree_bodies: this exact expression keeps the results of the
+    // Segments rule bit-identical to before issue 13, tests/scene/golden_run_test.cpp.)
+    for (int j = i; j >= 0; j = avatar.parents[j]) {
+      const Vec3 d = bodies[i].com_rest - avatar.joints_rest.row(j).transpose();
+      I[j] += bodies[i].inertia_rest + bodies[i].mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+    }
+  }
   return largest_moments(I);
 }
 

@@ -19,6 +19,7 @@
 //                  every `window` steps
 // The default list: shake@1/30, shake@1/15, torture@1/30, cmu_2x@1/30,
 // cmu_3x@1/30, fall_on_floor, box_press.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -75,7 +76,11 @@ void validate_stress_suite_options(const StressSuiteOptions& options);
 
 /// Runs the cases (progress on stderr). A case whose run throws (a missing
 /// scene file) is recorded as FAILED with the message; the suite goes on.
-std::vector<StressCaseResult> run_stress_suite(std::shared_ptr<const Avatar> avatar, const StressSuiteOptions& options);
+/// `on_case` (if given) sees the results so far after every case (e.g. to
+/// write the tables as the suite goes).
+std::vector<StressCaseResult> run_stress_suite(
+    std::shared_ptr<const Avatar> avatar, const StressSuiteOptions& options,
+    const std::function<void(const std::vector<StressCaseResult>&)>& on_case = {});
 
 /// The results as CSV (one row per case), a markdown table, and an SVG plot
 /// of the peak soft displacement per window over time (one line per case).
