@@ -11,7 +11,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
-#include "sflsh/motion/load_motion.hpp"
+#include "sflsh/scene/torture_motion.hpp"
 
 namespace sflsh {
 
@@ -24,6 +24,7 @@ std::string StressReport::describe() const {
     << "  min det F over samples:  " << min_det << (no_inversion ? "" : "  (INVERTED)") << "\n"
     << "  peak soft displacement:  first 10 % " << peak_soft_mm_early << " mm, last window " << peak_soft_mm_late
     << " mm" << (stable ? "" : "  (GROWING)") << "\n"
+    << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm << " mm\n"
     << "  result: " << (passed() ? "PASSED" : "FAILED") << "\n";
   return o.str();
 }
@@ -31,22 +32,25 @@ std::string StressReport::describe() const {
 StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOptions& o) {
   require(o.steps >= 1, "stress: steps must be >= 1, got ", o.steps);
   require(o.window >= 1, "stress: window must be >= 1, got ", o.window);
+  require(o.dt > 0 && std::isfinite(o.dt), "stress: dt must be positive, got ", o.dt);
+  require(o.speed > 0 && std::isfinite(o.speed), "stress: speed must be positive, got ", o.speed);
   MotionOptions mo;
   mo.rest_joints = avatar->joints_rest;
-  mo.builtin_seconds = double(o.steps) * o.dt + 1.0;  // built-ins cover the whole run
-  const MotionClip motion = load_motion(o.motion, mo);
+  mo.speed = o.speed;
+  mo.builtin_seconds = (double(o.steps) * o.dt + 1.0) * o.speed;  // built-ins cover the whole run
+  const MotionClip motion = load_stress_motion(o.motion, mo);
 
   RunOptions ro;
   ro.sim.h = o.dt;
   ro.sim.bones_dynamic = true;
-  ro.seconds = double(o.steps) * o.dt;
-  ro.output_fps = 1;  // frames are not kept; the callback records everything
+  ro.seconds = std::min(double(o.steps) * o.dt, motion.duration());
+  ro.output_fps = 10;  // pelvis error sampled 10 times per second  // frames are not kept; the callback records everything
   ro.keep_frames = false;
 
   StressReport r;
   r.min_det = std::numeric_limits<double>::infinity();
   StressWindow w;
-  std::vector<double> ms;
+  std::vector<double> ms, all_ms;
   w.min_det = std::numeric_limits<double>::infinity();
   long step = 0;
   ro.on_step = [&](const Simulator& sim, const StepReport& rep) {
@@ -64,10 +68,11 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     w.damped += rep.damped;
     w.rejected += rep.rejected;
     ms.push_back(rep.ms_total);
+    all_ms.push_back(rep.ms_total);
     r.accepted += rep.accepted;
     r.damped += rep.damped;
     r.rejected += rep.rejected;
-    if (step % o.window == 0 || step == o.steps) {
+    if (step % o.window == 0) {
       w.t_end = double(step) * o.dt;
       w.ms_median = percentile(ms, 0.5);
       r.windows.push_back(w);
@@ -77,19 +82,31 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     }
   };
   try {
-    run_simulation(avatar, motion, ro);
+    const SimulationResult res = run_simulation(avatar, motion, ro);
+    r.pelvis_error_max_mm = 1e3 * res.pelvis_error_max;
+    r.pelvis_error_mean_mm = 1e3 * res.pelvis_error_mean;
   } catch (const Error& e) {
     r.finite = false;
     std::fprintf(stderr, "stress: %s\n", e.what());
   }
   r.steps = step;
-  for (const StressWindow& x : r.windows) r.min_det = std::min(r.min_det, x.min_det);
+  if (step % o.window != 0 && !ms.empty()) {  // the last, partial window (a short motion or a stop)
+    w.t_end = double(step) * o.dt;
+    w.ms_median = percentile(ms, 0.5);
+    r.windows.push_back(w);
+  }
+  for (const StressWindow& x : r.windows) {
+    r.min_det = std::min(r.min_det, x.min_det);
+    r.peak_soft_mm = std::max(r.peak_soft_mm, x.peak_soft_mm);
+  }
+  if (!all_ms.empty()) r.ms_median = percentile(all_ms, 0.5);
   const size_t early = std::max<size_t>(1, r.windows.size() / 10);
   for (size_t i = 0; i < std::min(early, r.windows.size()); ++i)
     r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
   if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;
   r.no_inversion = r.min_det > 0;
-  r.stable = r.finite && r.steps == o.steps && r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
+  const long expected = std::min(o.steps, long(std::floor(motion.duration() / o.dt + 1e-9)));
+  r.stable = r.finite && r.steps == expected && r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
   return r;
 }
 

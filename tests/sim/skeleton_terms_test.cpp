@@ -185,6 +185,11 @@ std::vector<Configuration> walk(double f, const Vec3& start, bool soft_tissue) {
   so.soft_tissue_terms = soft_tissue;
   SkeletonTermsOptions o;
   o.body_mass = kBodyMass;
+  // The synthetic box carries flesh only on bones 0, 3 and 6: with the
+  // default carried-inertia springs its bare limbs would get springs sized by
+  // the skeleton's 15 % alone. The figures below are for springs sized by a
+  // whole body's segments, as on a real avatar whose limbs carry their flesh.
+  o.spring_inertia = SkeletonTermsOptions::SpringInertia::Segments;
   Simulator sim(avatar_model(avatar, so, &o));
   const Points& J = avatar->joints_rest;
   const auto& parents = avatar->parents;

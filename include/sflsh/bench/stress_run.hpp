@@ -15,7 +15,9 @@
 namespace sflsh {
 
 struct StressOptions {
+  /// builtin:NAME (also builtin:torture, scene/torture_motion.hpp) or a motion file.
   std::string motion = "builtin:shake";
+  double speed = 1;  ///< motion playback speed factor (> 0)
   double dt = 1.0 / 30.0;
   long steps = 10000;
   int window = 100;  ///< steps per summary window
@@ -38,6 +40,10 @@ struct StressReport {
   long steps = 0;
   int accepted = 0, damped = 0, rejected = 0;
   double min_det = 0;            ///< over the whole run
+  double peak_soft_mm = 0;       ///< over the whole run
+  /// Simulated pelvis vs the motion's root over the output frames (mm).
+  double pelvis_error_max_mm = 0, pelvis_error_mean_mm = 0;
+  double ms_median = 0;          ///< step wall time (ms)
   double peak_soft_mm_early = 0, peak_soft_mm_late = 0;  ///< first 10 % of windows, last window
   bool finite = true, stable = true, no_inversion = true;
   bool passed() const { return finite && stable && no_inversion; }
@@ -45,7 +51,9 @@ struct StressReport {
 };
 
 /// Runs the stress test (progress on stderr). Never throws on instability:
-/// a non-finite state ends the run and is reported (finite = false).
+/// a non-finite state ends the run and is reported (finite = false). A motion
+/// shorter than steps·dt ends the run early (report.steps says how many ran);
+/// built-in motions are made long enough.
 StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOptions& options);
 
 /// CSV (one row per window) and an SVG plot of peak soft displacement, elastic

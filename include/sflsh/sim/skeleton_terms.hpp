@@ -24,6 +24,22 @@ struct SkeletonTermsOptions {
   bool joint_limits = true;      ///< anatomical ranges (joint_limits_table.hpp)
   bool tracking = true;          ///< springs to ctx.target_pose
 
+  /// What the spring stiffnesses below (k_j = I_j (2π f)²) take as I_j:
+  ///  - Carried (default): the inertia about joint j of everything its
+  ///    rotation moves in the simulation, joint_carried_inertia(): the flesh
+  ///    (the avatar's inertia cubature, each sample moved by its skinning
+  ///    weights' share in the subtree) plus the skeleton's rigid bodies. Then
+  ///    every joint's springs have the frequency they are given. An avatar
+  ///    without an inertia cubature falls back to Segments.
+  ///  - Segments: Winter's segment masses as thin rods (bone_bodies with the
+  ///    whole body mass), the rule before issue 13. It undercounts the flesh
+  ///    on the leaves: on the default body the right hand carries 14.5× and
+  ///    the head 54× the rod's inertia, so their 20 Hz tracking springs ran at
+  ///    5.2 and 2.7 Hz, and `shake` (5 Hz) drove the right hand into ±0.8 rad
+  ///    flapping against the rotation cap (1,666 of 10,000 steps damped).
+  enum class SpringInertia { Carried, Segments };
+  SpringInertia spring_inertia = SpringInertia::Carried;
+
   /// Joint constraint stiffness k = ratio · body_mass / h² (N/m): a force
   /// body_mass·a opens a joint by a h²/ratio (0.03 mm for g at h = 1/60 s).
   double joint_stiffness_ratio = 100.0;
@@ -57,6 +73,18 @@ double estimate_body_mass(const Avatar& avatar);
 /// joint's subtree of `bodies`, parallel-axis theorem about J̄_j): the largest
 /// principal moment, #J. Joint 0: the whole body about the root joint.
 std::vector<double> joint_subtree_inertia(const Avatar& avatar, const std::vector<BoneBody>& bodies);
+
+/// Rotational inertia (kg m²) about each joint j of everything its rotation
+/// moves in the simulator, as the largest principal moment (#J):
+///   I_j = Σ_s m_s W_sj² (|d_s|² I − d_s d_sᵀ) + Σ_{i ∈ subtree(j)} (rigid body i about J̄_j),
+/// d_s = x̄_s − J̄_j, over the avatar's inertia cubature samples s (mass m_s =
+/// density × weight, cubature_masses) with W_sj = Σ_{b ∈ subtree(j)} w_sb the
+/// share of the sample's skinning weights that joint j turns (a sample moves
+/// W_sj as far as the subtree does: the Gauss–Newton inertia Jᵀ M J the
+/// Newton step sees), plus `skeleton` (the bones' own rigid bodies, #J) by the
+/// parallel-axis theorem. Unposed rest frame. Throws when the avatar has no
+/// inertia cubature or `skeleton` does not have one body per joint.
+std::vector<double> joint_carried_inertia(const Avatar& avatar, const std::vector<BoneBody>& skeleton);
 
 /// Appends the enabled skeletal terms to `terms`, in the order inertia,
 /// gravity, joint constraints, joint limits, tracking.
