@@ -30,8 +30,8 @@ struct ShapeOptions {
   /// tet's angles a little).
   double min_dihedral_deg = 2.0;
   /// The shaped mesh is optimized (below) only if some tet's smallest
-  /// dihedral angle is below this (deg) and below the template mesh's
-  /// smallest; otherwise the nodes stay exactly where the shape and thickness
+  /// dihedral angle is below this (deg), also where the template itself is
+  /// below it; otherwise the nodes stay exactly where the shape and thickness
   /// map put them.
   double quality_floor_deg = 8.0;
   /// Optimization of the placed mesh (after the thickness map): interior
@@ -45,6 +45,16 @@ struct ShapeOptions {
   /// candidate projected onto it, so they stay exactly on the skin), at most
   /// this fraction of their shortest edge. 0 skips the round.
   double skin_slide_fraction = 0.3;
+  /// Rounds of untangling where the node paths fold (before the optimization):
+  /// the displacement from the template of the nodes off the skin around the
+  /// inverted tets is replaced by its harmonic extension, over a region
+  /// growing by two rings per round. 0 skips it.
+  int untangle_rounds = 6;
+  /// Remove tets with all four nodes and two faces on the skin that are
+  /// inverted or below the floor (a boundary edge flip where the shape made a
+  /// convex ridge of the skin concave; see mesh/boundary_caps.hpp), before and
+  /// after the optimization.
+  bool remove_bad_caps = true;
 };
 
 struct ShapeReport {
@@ -53,6 +63,11 @@ struct ShapeReport {
   int num_embedded_outside = 0;
   /// Nodes whose thickness scale was relaxed towards 1 to avoid inverted tets.
   int num_relaxed_nodes = 0;
+  /// Nodes off the skin whose displacement was made harmonic to untangle folds
+  /// (summed over the rounds).
+  int untangled_nodes = 0;
+  /// Skin cap tets removed (the avatar has that many fewer tets than the template).
+  int caps_removed = 0;
   /// The interior/bone-surface node optimization (quality before/after it),
   /// and the second round with skin nodes sliding (passes = 0 if not run).
   InteriorSmoothingReport smoothing, skin_smoothing;
