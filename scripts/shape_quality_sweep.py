@@ -56,11 +56,12 @@ def main():
     ap.add_argument("--shared", default=os.environ.get("SFLSH_SHARED_DIR", os.path.join(ROOT, "..", "shared")))
     ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results", "shape_quality.md"))
     a = ap.parse_args()
+    all_ok = True
     binary = os.path.join(a.build, "test_precompute")
     if not os.path.exists(binary):
         sys.exit("shape_quality_sweep: %s not found (build it: scripts/build.sh --target test_precompute)" % binary)
 
-    sections, all_ok = [], True
+    sections = []
     for model in a.models.split(","):
         if model == "procedural":
             rows, wall = run_sweep(binary, "procedural", a.random)
@@ -80,7 +81,13 @@ def main():
                              % len(rows), rows, wall))
         else:
             sys.exit("shape_quality_sweep: --models: unknown model '%s' (expected procedural, makehuman)" % model)
+        all_ok = write(a.out, sections)  # after every body, so a long run leaves what it measured
+    print("shape_quality_sweep: wrote %s (%s)" % (a.out, "all shapes meet the bar" if all_ok else "SOME SHAPES FAIL"))
+    return 0 if all_ok else 1
 
+
+def write(path, sections):
+    all_ok = True
     out = ["# Shaped-mesh quality over the shape space", "",
            "Written by `scripts/shape_quality_sweep.py` (%s). Bar: every shape min dihedral >= 8 deg, 0 inverted."
            % time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
@@ -98,12 +105,11 @@ def main():
                 for r in rows]
         out.append("")
         all_ok = all_ok and good == len(rows)
-    os.makedirs(os.path.dirname(a.out), exist_ok=True)
-    with open(a.out + ".partial", "w") as f:
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path + ".partial", "w") as f:
         f.write("\n".join(out))
-    os.replace(a.out + ".partial", a.out)
-    print("shape_quality_sweep: wrote %s (%s)" % (a.out, "all shapes meet the bar" if all_ok else "SOME SHAPES FAIL"))
-    return 0 if all_ok else 1
+    os.replace(path + ".partial", path)
+    return all_ok
 
 
 if __name__ == "__main__":

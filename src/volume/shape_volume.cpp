@@ -1,12 +1,14 @@
 #include "sflsh/volume/shape_volume.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <sstream>
 
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/mesh/boundary_caps.hpp"
+#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/point_embedding.hpp"
 #include "sflsh/volume/surface_query.hpp"
@@ -21,6 +23,9 @@ std::string ShapeReport::describe() const {
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
   if (untangled_nodes > 0) os << "; displacement made harmonic at " << untangled_nodes << " folded nodes";
   if (caps_removed > 0) os << "; " << caps_removed << " flattened skin caps removed";
+  if (flips.flips_2_3 + flips.flips_3_2 > 0)
+    os << "; " << flips.flips_2_3 << " 2-3 and " << flips.flips_3_2 << " 3-2 flips (min dihedral "
+       << flips.min_dihedral_before << " -> " << flips.min_dihedral_after << " deg)";
   if (smoothing.passes > 0)
     os << "\n  interior optimization: min dihedral " << smoothing.min_dihedral_before << " -> "
        << smoothing.min_dihedral_after << " deg, tets below " << smoothing.below_target_before << " -> "
@@ -262,19 +267,41 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     for (int n = 0; n < N; ++n)
       if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
     out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
+    const SurfaceQuery skin(v_shaped, F);
+    InteriorSmoothingOptions so = o.smoothing;
+    so.max_displacement_fraction = o.skin_slide_fraction;
     if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor) {
       // Skin nodes of the tets still below the floor slide along the shaped skin.
-      const SurfaceQuery skin(v_shaped, F);
       for (int t = 0; t < av.tet.num_elements(); ++t)
         if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
           for (int i = 0; i < 4; ++i)
             if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
-      InteriorSmoothingOptions so = o.smoothing;
-      so.max_displacement_fraction = o.skin_slide_fraction;
       out.report.skin_smoothing = smooth_interior_nodes(av.tet, freedom, normals, so,
                                                         [&](const Vec3& y) { return skin.closest_point(y); });
     }
     remove_caps();
+    if (o.flip_rounds > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+      // Where no node move helps (tets between two skin patches, ears of the
+      // skin surface), 2-3 and 3-2 flips; then the node moves once more.
+      std::vector<int> parent;
+      out.report.flips = flip_bad_tets(av.tet, o.smoothing.target_deg, o.flip_rounds, &parent);
+      if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
+      for (int& t : parent) t = kept_tets[t];
+      kept_tets = parent;
+      if (out.report.flips.min_dihedral_after < quality_floor) {
+        for (int t = 0; t < av.tet.num_elements(); ++t)
+          if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
+            for (int i = 0; i < 4; ++i)
+              if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
+        // A wider reach on the skin: what is left are mostly ears (a skin node
+        // in a single tet, its three faces on the skin) that only moving
+        // along the skin can raise.
+        InteriorSmoothingOptions wide = so;
+        wide.max_displacement_fraction = o.final_skin_slide_fraction;
+        smooth_interior_nodes(av.tet, freedom, normals, wide, [&](const Vec3& y) { return skin.closest_point(y); });
+      }
+      remove_caps();
+    }
   }
   if (kept_tets.empty()) {
     av.tet_region = tv.tet_region;

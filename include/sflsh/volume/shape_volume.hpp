@@ -6,6 +6,7 @@
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/body_model.hpp"
 #include "sflsh/mesh/interior_smoothing.hpp"
+#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 #include "sflsh/volume/template_volume.hpp"
 #include "sflsh/volume/thickness_map.hpp"
@@ -55,6 +56,13 @@ struct ShapeOptions {
   /// convex ridge of the skin concave; see mesh/boundary_caps.hpp), before and
   /// after the optimization.
   bool remove_bad_caps = true;
+  /// Sweeps of 2-3/3-2 flips on the tets still below smoothing.target_deg
+  /// after the node moves (mesh/tet_flips.hpp), followed by one more round of
+  /// node moves. 0 skips them.
+  int flip_rounds = 4;
+  /// Reach of the skin nodes in that last round of node moves (fraction of
+  /// their shortest edge, from where they are after the flips).
+  double final_skin_slide_fraction = 1.0;
 };
 
 struct ShapeReport {
@@ -68,6 +76,8 @@ struct ShapeReport {
   int untangled_nodes = 0;
   /// Skin cap tets removed (the avatar has that many fewer tets than the template).
   int caps_removed = 0;
+  /// Flips made after the node moves (the tet count changes by one per flip).
+  TetFlipReport flips;
   /// The interior/bone-surface node optimization (quality before/after it),
   /// and the second round with skin nodes sliding (passes = 0 if not run).
   InteriorSmoothingReport smoothing, skin_smoothing;
