@@ -8,11 +8,21 @@
 namespace sflsh {
 namespace {
 
-// Triangle (0,0,0), (1,0,0), (0,1,0) with apex a above at height ha and e below at depth he.
+// Nodes: the triangle (0,0,0), (1,0,0), (0,1,0), then a and e.
 Points bipyramid(const Vec3& a, const Vec3& e) {
   Points x(5, 3);
   x << 0, 0, 0, 1, 0, 0, 0, 1, 0, a.x(), a.y(), a.z(), e.x(), e.y(), e.z();
   return x;
+}
+
+// The two tets (triangle, a) and (triangle, e) sharing the triangle.
+TetMesh two_tets(const Vec3& a, const Vec3& e) {
+  TetMesh m;
+  m.nodes = bipyramid(a, e);
+  m.elements.resize(2, 4);
+  m.elements << 0, 1, 2, 3, 0, 1, 2, 4;
+  orient_tets_positively(m);
+  return m;
 }
 
 double volume(const TetMesh& m) {
@@ -24,11 +34,7 @@ double volume(const TetMesh& m) {
 TEST(TetFlips, TwoThreeFlipReplacesASliverOnAFace) {
   // Apex 2 cm over the triangle: the upper tet is a sliver; the edge a-e crosses the triangle
   // at (0.3, 0.3), inside, so the three tets around a-e fill the same volume, area/3 * (0.02 + 1).
-  TetMesh m;
-  m.nodes = bipyramid(Vec3(0.3, 0.3, 0.02), Vec3(0.3, 0.3, -1));
-  m.elements.resize(2, 4);
-  m.elements << 0, 1, 2, 3, 0, 1, 2, 4;
-  orient_tets_positively(m);
+  TetMesh m = two_tets(Vec3(0.3, 0.3, 0.02), Vec3(0.3, 0.3, -1));
   const double before = tet_quality_report(m).min_dihedral_deg;
   std::vector<int> parent;
   const TetFlipReport r = flip_bad_tets(m, 30.0, 4, &parent);
@@ -46,11 +52,7 @@ TEST(TetFlips, TwoThreeFlipReplacesASliverOnAFace) {
 
 TEST(TetFlips, NoFlipWhenTheEdgeMissesTheFace) {
   // a-e passes outside the triangle (x + y > 1): a 2-3 flip would overlap; nothing changes.
-  TetMesh m;
-  m.nodes = bipyramid(Vec3(0.9, 0.9, 0.02), Vec3(0.9, 0.9, -1));
-  m.elements.resize(2, 4);
-  m.elements << 0, 1, 2, 3, 0, 1, 2, 4;
-  orient_tets_positively(m);
+  TetMesh m = two_tets(Vec3(0.9, 0.9, 0.02), Vec3(0.9, 0.9, -1));
   const Tets old = m.elements;
   const TetFlipReport r = flip_bad_tets(m, 30.0);
   EXPECT_EQ(r.flips_2_3 + r.flips_3_2, 0);
@@ -68,10 +70,7 @@ TEST(TetFlips, ThreeTwoFlipRemovesALongEdge) {
   orient_tets_positively(m);
   double three = 180;
   for (int t = 0; t < 3; ++t) three = std::min(three, tet_quality(m, t).min_dihedral_deg);
-  TetMesh two = m;
-  two.elements.resize(2, 4);
-  two.elements << 0, 1, 2, 3, 0, 1, 2, 4;
-  orient_tets_positively(two);
+  const TetMesh two = two_tets(Vec3(0.05, 0.05, 1), Vec3(0.05, 0.05, -1));
   ASSERT_GT(tet_quality_report(two).min_dihedral_deg, three);
   const TetFlipReport r = flip_bad_tets(m, 60.0);
   EXPECT_EQ(r.flips_3_2, 1);
