@@ -190,7 +190,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   // sweeps of the graph Laplacian; the skin and the nodes outside the region
   // stay). A smooth displacement of the template, which is good, keeps the
   // tets' shape; the region grows each round until nothing folds.
-  for (int round = 0; round < o.untangle_rounds; ++round) {
+  for (int round = 0; o.smoothing.passes > 0 && round < o.untangle_rounds; ++round) {
     std::vector<char> region(N, 0);
     int folded = 0;
     for (int t = 0; t < tv.tet.num_elements(); ++t) {
@@ -240,7 +240,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     // Tets with all four nodes on the skin and two faces on it, which the
     // shape flattened or turned inside out by making a convex ridge of the
     // skin concave: removed (a boundary edge flip; no node moves).
-    if (!o.remove_bad_caps) return;
+    if (!o.remove_bad_caps || o.smoothing.passes == 0) return;
     std::vector<int> kept;
     out.report.caps_removed += remove_bad_boundary_caps(av.tet, on_skin, quality_floor, &kept).removed;
     if (kept_tets.empty()) {

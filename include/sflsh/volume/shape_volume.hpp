@@ -38,7 +38,8 @@ struct ShapeOptions {
   /// Optimization of the placed mesh (after the thickness map): interior
   /// nodes move freely, bone-surface nodes slide across their paths (in the
   /// plane orthogonal to skeleton point -> skin point), skin nodes stay, until
-  /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it.
+  /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it
+  /// and also the untangling, cap removal and flips below (the bare placement).
   InteriorSmoothingOptions smoothing;
   /// If tets stay below quality_floor_deg after that (tets with all four nodes on the
   /// skin, where the shape flattened the skin), a second round also lets the
