@@ -31,6 +31,30 @@ MeshScan scan(const TetMesh& mesh, double target_deg, std::vector<char>* bad) {
   return s;
 }
 
+// The smallest dihedral angle (deg) of node n's star with n at x if no tet of
+// it is inverted; otherwise -1 - (number of inverted tets) - a term in (0, 1)
+// growing with their total negative volume (relative to h^3), so a move that
+// untangles part of a folded star counts as an improvement.
+double star_score(const TetMesh& mesh, const std::vector<int>& star, int n, const Vec3& x, double h) {
+  double worst = std::numeric_limits<double>::infinity(), negative = 0;
+  int inverted = 0;
+  for (int t : star) {
+    Vec3 p[4];
+    for (int i = 0; i < 4; ++i) {
+      const int m = mesh.elements(t, i);
+      p[i] = m == n ? x : Vec3(mesh.nodes.row(m).transpose());
+    }
+    const TetQuality q = tet_quality(p[0], p[1], p[2], p[3]);
+    if (!(q.signed_volume > 0)) {
+      ++inverted;
+      negative += std::isfinite(q.signed_volume) ? -q.signed_volume : 1e300;
+    }
+    worst = std::min(worst, q.min_dihedral_deg);
+  }
+  if (inverted == 0) return worst;
+  return -1.0 - inverted - std::tanh(negative / (h * h * h));
+}
+
 }  // namespace
 
 InteriorSmoothingReport smooth_interior_nodes(TetMesh& mesh, const std::vector<NodeFreedom>& freedom,
@@ -76,13 +100,13 @@ InteriorSmoothingReport smooth_interior_nodes(TetMesh& mesh, const std::vector<N
     int moved = 0;
     for (int n : nodes) {
       const Vec3 x = mesh.nodes.row(n).transpose();
-      const double q0 = star_min_dihedral(mesh, star[n], n, x);
+      double h = std::numeric_limits<double>::infinity();
+      for (int m : nbr[n]) h = std::min(h, (mesh.nodes.row(m).transpose() - x).norm());
+      const double q0 = star_score(mesh, star[n], n, x, h);
       if (q0 >= o.target_deg) continue;
       const bool slide = freedom[n] == NodeFreedom::Slide, on_surface = freedom[n] == NodeFreedom::Surface;
       const Vec3 nu = slide ? Vec3(slide_normals.row(n).transpose()) : Vec3::Zero();
       auto project = [&](const Vec3& d) -> Vec3 { return slide ? Vec3(d - d.dot(nu) * nu) : d; };
-      double h = std::numeric_limits<double>::infinity();
-      for (int m : nbr[n]) h = std::min(h, (mesh.nodes.row(m).transpose() - x).norm());
       if (reach[n] < 0) reach[n] = o.max_displacement_fraction * h;
       const Vec3 x0 = start.row(n).transpose();
 
@@ -118,7 +142,7 @@ InteriorSmoothingReport smooth_interior_nodes(TetMesh& mesh, const std::vector<N
       for (Vec3 y : cand) {
         if (on_surface) y = project_to_surface(y);
         if ((y - x0).norm() > reach[n]) continue;
-        const double q = star_min_dihedral(mesh, star[n], n, y);
+        const double q = star_score(mesh, star[n], n, y, h);
         if (q > best + 1e-9) best = q, best_x = y;
       }
       if (best_x != x) {

@@ -1,11 +1,14 @@
 #include "sflsh/volume/shape_volume.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <sstream>
 
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/mesh/boundary_caps.hpp"
+#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/point_embedding.hpp"
 #include "sflsh/volume/surface_query.hpp"
@@ -18,6 +21,11 @@ std::string ShapeReport::describe() const {
      << " skin vertices outside the tet mesh, farthest " << max_embedding_distance * 1e3 << " mm; shape stage "
      << seconds << " s";
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
+  if (untangled_nodes > 0) os << "; displacement made harmonic at " << untangled_nodes << " folded nodes";
+  if (caps_removed > 0) os << "; " << caps_removed << " flattened skin caps removed";
+  if (flips.flips_2_3 + flips.flips_3_2 > 0)
+    os << "; " << flips.flips_2_3 << " 2-3 and " << flips.flips_3_2 << " 3-2 flips (min dihedral "
+       << flips.min_dihedral_before << " -> " << flips.min_dihedral_after << " deg)";
   if (smoothing.passes > 0)
     os << "\n  interior optimization: min dihedral " << smoothing.min_dihedral_before << " -> "
        << smoothing.min_dihedral_after << " deg, tets below " << smoothing.below_target_before << " -> "
@@ -170,14 +178,79 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   }
   for (int n = 0; n < N; ++n) out.report.num_relaxed_nodes += relax[n] < 1.0;
 
+  std::vector<char> on_skin(N, 0);
+  for (int i = 0; i < tv.outer_nodes.size(); ++i) on_skin[tv.outer_nodes[i]] = 1;
+  if (nbr.empty()) nbr = tet_node_neighbours(tv.tet);
+
+  // Untangling where the node paths fold (a shape that shortens a limb by
+  // decimetres crowds the paths of the calf or thigh so that bone-surface
+  // nodes overtake skin nodes): around the inverted tets that have a node off
+  // the skin, the displacement from the template of the nodes off the skin is
+  // replaced by its harmonic extension from the surrounding nodes (Jacobi
+  // sweeps of the graph Laplacian; the skin and the nodes outside the region
+  // stay). A smooth displacement of the template, which is good, keeps the
+  // tets' shape; the region grows each round until nothing folds.
+  for (int round = 0; o.smoothing.passes > 0 && round < o.untangle_rounds; ++round) {
+    std::vector<char> region(N, 0);
+    int folded = 0;
+    for (int t = 0; t < tv.tet.num_elements(); ++t) {
+      if (tet_quality(av.tet, t).signed_volume > 0) continue;
+      bool off_skin = false;
+      for (int i = 0; i < 4; ++i) off_skin = off_skin || !on_skin[tv.tet.elements(t, i)];
+      if (!off_skin) continue;
+      ++folded;
+      for (int i = 0; i < 4; ++i) region[tv.tet.elements(t, i)] = !on_skin[tv.tet.elements(t, i)];
+    }
+    if (folded == 0) break;
+    for (int ring = 0; ring < 2 * (round + 1); ++ring) {
+      std::vector<char> next = region;
+      for (int n = 0; n < N; ++n)
+        if (region[n])
+          for (int u : nbr[n]) next[u] = next[u] || !on_skin[u];
+      region.swap(next);
+    }
+    Points u = av.tet.nodes - tv.tet.nodes;
+    std::vector<int> ids;
+    for (int n = 0; n < N; ++n)
+      if (region[n]) ids.push_back(n);
+    for (int it = 0; it < 200; ++it) {
+      Points next = u;
+      for (int n : ids) {
+        Vec3 m = Vec3::Zero();
+        for (int w : nbr[n]) m += u.row(w).transpose();
+        next.row(n) = (m / double(nbr[n].size())).transpose();
+      }
+      u.swap(next);
+    }
+    for (int n : ids) av.tet.nodes.row(n) = tv.tet.nodes.row(n) + u.row(n);
+    out.report.untangled_nodes += int(ids.size());
+  }
+
   // Interior optimization: the thickness map (and a shape that stretches the
   // layer unevenly) flattens some tets of the thin shell, where nearly every
   // tet joins skin nodes to bone-surface nodes; the skin stays, the
   // bone-surface nodes slide across their paths (their depth along the path
   // is kept to first order), interior nodes move freely.
-  // The floor: quality_floor_deg, or the template's own minimum if that is lower (a shape
-  // is not asked to make the mesh better than the template).
-  const double quality_floor = std::min(o.quality_floor_deg, tet_quality_report(tv.tet).min_dihedral_deg);
+  // The floor is quality_floor_deg even where the template is below it (its
+  // skin-only tets, which the template stage cannot move): the skin nodes
+  // slide along the skin below.
+  const double quality_floor = o.quality_floor_deg;
+  std::vector<int> kept_tets;
+  auto remove_caps = [&] {
+    // Tets with all four nodes on the skin and two faces on it, which the
+    // shape flattened or turned inside out by making a convex ridge of the
+    // skin concave: removed (a boundary edge flip; no node moves).
+    if (!o.remove_bad_caps || o.smoothing.passes == 0) return;
+    std::vector<int> kept;
+    out.report.caps_removed += remove_bad_boundary_caps(av.tet, on_skin, quality_floor, &kept).removed;
+    if (kept_tets.empty()) {
+      kept_tets = kept;
+    } else {
+      for (int& t : kept) t = kept_tets[t];
+      kept_tets = kept;
+    }
+  };
+  remove_caps();
   if (o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
     std::vector<NodeFreedom> freedom(N, NodeFreedom::Free);
     Points normals = Points::Zero(N, 3);
@@ -191,23 +264,50 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
         freedom[n] = NodeFreedom::Fixed;
       }
     }
-    std::vector<char> on_skin(N, 0);
-    for (int i = 0; i < tv.outer_nodes.size(); ++i) on_skin[tv.outer_nodes[i]] = 1;
     for (int n = 0; n < N; ++n)
       if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
     out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
+    const SurfaceQuery skin(v_shaped, F);
+    InteriorSmoothingOptions so = o.smoothing;
+    so.max_displacement_fraction = o.skin_slide_fraction;
     if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor) {
       // Skin nodes of the tets still below the floor slide along the shaped skin.
-      const SurfaceQuery skin(v_shaped, F);
-      for (int t = 0; t < tv.tet.num_elements(); ++t)
+      for (int t = 0; t < av.tet.num_elements(); ++t)
         if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
           for (int i = 0; i < 4; ++i)
             if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
-      InteriorSmoothingOptions so = o.smoothing;
-      so.max_displacement_fraction = o.skin_slide_fraction;
       out.report.skin_smoothing = smooth_interior_nodes(av.tet, freedom, normals, so,
                                                         [&](const Vec3& y) { return skin.closest_point(y); });
     }
+    remove_caps();
+    if (o.flip_rounds > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+      // Where no node move helps (tets between two skin patches, ears of the
+      // skin surface), 2-3 and 3-2 flips; then the node moves once more.
+      std::vector<int> parent;
+      out.report.flips = flip_bad_tets(av.tet, o.smoothing.target_deg, o.flip_rounds, &parent);
+      if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
+      for (int& t : parent) t = kept_tets[t];
+      kept_tets = parent;
+      if (out.report.flips.min_dihedral_after < quality_floor) {
+        for (int t = 0; t < av.tet.num_elements(); ++t)
+          if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
+            for (int i = 0; i < 4; ++i)
+              if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
+        // A wider reach on the skin: what is left are mostly ears (a skin node
+        // in a single tet, its three faces on the skin) that only moving
+        // along the skin can raise.
+        InteriorSmoothingOptions wide = so;
+        wide.max_displacement_fraction = o.final_skin_slide_fraction;
+        smooth_interior_nodes(av.tet, freedom, normals, wide, [&](const Vec3& y) { return skin.closest_point(y); });
+      }
+      remove_caps();
+    }
+  }
+  if (kept_tets.empty()) {
+    av.tet_region = tv.tet_region;
+  } else {
+    av.tet_region.resize(kept_tets.size());
+    for (size_t i = 0; i < kept_tets.size(); ++i) av.tet_region[i] = tv.tet_region[kept_tets[i]];
   }
   out.report.quality = tet_quality_report(av.tet);
   require(out.report.quality.num_inverted == 0, "shape_volume: ", out.report.quality.num_inverted,
@@ -235,7 +335,6 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   av.node_weights = tv.node_weights;
   av.node_role = tv.node_role;
   av.surface_nodes = tv.outer_nodes;
-  av.tet_region = tv.tet_region;
   av.materials = default_region_materials();
   av.tet_frames = tet_frames(av.tet, sb, tv.node_segment, tv.segments, model.parents, joints);
   av.capsules = fit_bone_capsules(av.tet.nodes, sb, tv.outer_nodes, tv.node_segment, tv.segments,

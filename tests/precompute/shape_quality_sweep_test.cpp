@@ -1,15 +1,18 @@
-// Quality of the shaped tet mesh over the shape space (slow; run explicitly):
+// Quality of the shaped tet mesh over the shape space (slow; run explicitly, or through
+// scripts/shape_quality_sweep.py, which writes scripts/results/shape_quality.md):
 //
-//   SFLSH_SWEEP_MODEL=procedural|model.h5  SFLSH_SWEEP_CORNERS=1024  SFLSH_SWEEP_RANDOM=100 \
-//   SFLSH_SWEEP_BETAS=extra.csv  nice build/test_precompute --gtest_also_run_disabled_tests \
-//       --gtest_filter='ShapeQualitySweep.*'
+//   SFLSH_SWEEP_MODEL=procedural|model.h5  SFLSH_SWEEP_CORNERS=32|all|0  SFLSH_SWEEP_RANDOM=100 \
+//   SFLSH_SWEEP_DIRECTIONS=0|1  SFLSH_SWEEP_BETAS=extra.csv  nice build/test_precompute \
+//       --gtest_also_run_disabled_tests --gtest_filter='ShapeQualitySweep.*'
 //
-// Shapes: corners of [-3, 3]^10 (the first 10 betas; SFLSH_SWEEP_CORNERS < 1024 takes that many
-// corners drawn with a fixed seed, always including all -3 and all +3), uniform random draws in
-// the same box (seed 2026), and the rows of an optional CSV (`name,b0,b1,...`, e.g. the
-// MakeHuman targets from data_tools/makehuman_to_smpl.py --target-betas). Each goes through the
-// shape stage's geometry (shape_volume, default thickness map); every one must keep its minimum
-// dihedral angle >= 8 deg with no inverted tet. Template stage from the precompute cache.
+// Shapes: beta = 0; corners of [-3, 3]^10 (the first 10 betas): every sign pattern of the first
+// 4 with the others at +-3 alternating, both phases (32 corners; "all" = all 1024, "0" = none);
+// each direction alone at -3 and +3 (SFLSH_SWEEP_DIRECTIONS=1); uniform random draws in the box
+// (seed 2026); and the rows of an optional CSV (`name,b0,b1,...`, e.g. the MakeHuman targets
+// from data_tools/makehuman_to_smpl.py --target-betas). Each goes through the shape stage's
+// geometry (shape_volume, default thickness map); every one must keep its minimum dihedral angle
+// >= 8 deg with no inverted tet. Template stage from the precompute cache. One machine-readable
+// line per shape: SWEEP|name|min dihedral deg|inverted|tets below 8 deg|caps removed|seconds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,21 +48,37 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
   const double range = 3.0;
 
   std::vector<std::pair<std::string, VecX>> shapes;
-  const int corners = std::clamp(env_int("SFLSH_SWEEP_CORNERS", 1 << D), 0, 1 << D);
-  std::vector<int> ids(1 << D);
-  for (int i = 0; i < (1 << D); ++i) ids[i] = i;
-  if (corners < (1 << D)) {
-    std::mt19937 pick(2026);
-    std::shuffle(ids.begin() + 1, ids.end() - 1, pick);  // keep all -3 (0) and all +3 (last) first
-    std::swap(ids[1], ids.back());
-    ids.resize(corners);
+  shapes.emplace_back("zero", VecX::Zero(B));
+  // Corners: every sign pattern of the first 4 components, the other components at +-3
+  // alternating (starting with + and with -): 32 corners, including the ones that stack the
+  // extremes of the leading directions. SFLSH_SWEEP_CORNERS=all takes all 2^D corners.
+  const char* corner_env = std::getenv("SFLSH_SWEEP_CORNERS");
+  const bool all_corners = corner_env && std::string(corner_env) == "all";
+  const bool no_corners = corner_env && std::string(corner_env) == "0";
+  const int lead = std::min(D, 4);
+  int corners = 0;
+  if (!no_corners) {
+    const int count = all_corners ? (1 << D) : (1 << lead) * (D > lead ? 2 : 1);
+    for (int id = 0; id < count; ++id) {
+      VecX b = VecX::Zero(B);
+      std::string name = "corner ";
+      for (int d = 0; d < D; ++d) {
+        const bool plus = all_corners || d < lead ? (id >> d & 1) : ((d - lead + (id >> lead)) % 2 == 0);
+        b[d] = plus ? range : -range;
+        name += plus ? '+' : '-';
+      }
+      shapes.emplace_back(name, b);
+      ++corners;
+    }
   }
-  for (int id : ids) {
-    VecX b = VecX::Zero(B);
-    std::string name = "corner ";
-    for (int d = 0; d < D; ++d) b[d] = (id >> d & 1) ? range : -range, name += (id >> d & 1) ? '+' : '-';
-    shapes.emplace_back(name, b);
-  }
+  // Each direction alone at -3 and +3 (SFLSH_SWEEP_DIRECTIONS=1).
+  if (env_int("SFLSH_SWEEP_DIRECTIONS", 0))
+    for (int d = 0; d < D; ++d)
+      for (double v : {-range, range}) {
+        VecX b = VecX::Zero(B);
+        b[d] = v;
+        shapes.emplace_back("beta" + std::to_string(d) + (v > 0 ? "=+3" : "=-3"), b);
+      }
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> U(-range, range);
   for (int i = 0, n = env_int("SFLSH_SWEEP_RANDOM", 100); i < n; ++i) {
@@ -92,6 +111,8 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       const TetQualityReport& q = s.report.quality;
       const double sec = t.seconds();
       total_s += sec;
+      std::printf("SWEEP|%s|%.3f|%d|%d|%d|%.2f\n", name.c_str(), q.min_dihedral_deg, q.num_inverted,
+                  q.num_below_threshold, s.report.caps_removed, sec);
       std::printf("%-24s min dihedral %6.3f deg (before the interior optimization %6.3f), %d below 8, %d inverted, "
                   "%d nodes moved, %d tets below target on fixed nodes only, %d skin nodes slid (max %.2f mm), %.2f s\n",
                   name.c_str(), q.min_dihedral_deg, s.report.smoothing.min_dihedral_before, q.num_below_threshold,
@@ -121,6 +142,7 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       failed += !ok;
       EXPECT_TRUE(ok) << name << ": min dihedral " << q.min_dihedral_deg << ", " << q.num_inverted << " inverted";
     } catch (const Error& e) {
+      std::printf("SWEEP|%s|failed|-|-|-|%.2f\n", name.c_str(), t.seconds());
       ++failed;
       ADD_FAILURE() << name << ": " << e.what();
     }

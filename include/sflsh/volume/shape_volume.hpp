@@ -6,6 +6,7 @@
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/body_model.hpp"
 #include "sflsh/mesh/interior_smoothing.hpp"
+#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 #include "sflsh/volume/template_volume.hpp"
 #include "sflsh/volume/thickness_map.hpp"
@@ -30,14 +31,15 @@ struct ShapeOptions {
   /// tet's angles a little).
   double min_dihedral_deg = 2.0;
   /// The shaped mesh is optimized (below) only if some tet's smallest
-  /// dihedral angle is below this (deg) and below the template mesh's
-  /// smallest; otherwise the nodes stay exactly where the shape and thickness
+  /// dihedral angle is below this (deg), also where the template itself is
+  /// below it; otherwise the nodes stay exactly where the shape and thickness
   /// map put them.
   double quality_floor_deg = 8.0;
   /// Optimization of the placed mesh (after the thickness map): interior
   /// nodes move freely, bone-surface nodes slide across their paths (in the
   /// plane orthogonal to skeleton point -> skin point), skin nodes stay, until
-  /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it.
+  /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it
+  /// and also the untangling, cap removal and flips below (the bare placement).
   InteriorSmoothingOptions smoothing;
   /// If tets stay below quality_floor_deg after that (tets with all four nodes on the
   /// skin, where the shape flattened the skin), a second round also lets the
@@ -45,6 +47,23 @@ struct ShapeOptions {
   /// candidate projected onto it, so they stay exactly on the skin), at most
   /// this fraction of their shortest edge. 0 skips the round.
   double skin_slide_fraction = 0.3;
+  /// Rounds of untangling where the node paths fold (before the optimization):
+  /// the displacement from the template of the nodes off the skin around the
+  /// inverted tets is replaced by its harmonic extension, over a region
+  /// growing by two rings per round. 0 skips it.
+  int untangle_rounds = 6;
+  /// Remove tets with all four nodes and two faces on the skin that are
+  /// inverted or below the floor (a boundary edge flip where the shape made a
+  /// convex ridge of the skin concave; see mesh/boundary_caps.hpp), before and
+  /// after the optimization.
+  bool remove_bad_caps = true;
+  /// Sweeps of 2-3/3-2 flips on the tets still below smoothing.target_deg
+  /// after the node moves (mesh/tet_flips.hpp), followed by one more round of
+  /// node moves. 0 skips them.
+  int flip_rounds = 4;
+  /// Reach of the skin nodes in that last round of node moves (fraction of
+  /// their shortest edge, from where they are after the flips).
+  double final_skin_slide_fraction = 1.0;
 };
 
 struct ShapeReport {
@@ -53,6 +72,13 @@ struct ShapeReport {
   int num_embedded_outside = 0;
   /// Nodes whose thickness scale was relaxed towards 1 to avoid inverted tets.
   int num_relaxed_nodes = 0;
+  /// Nodes off the skin whose displacement was made harmonic to untangle folds
+  /// (summed over the rounds).
+  int untangled_nodes = 0;
+  /// Skin cap tets removed (the avatar has that many fewer tets than the template).
+  int caps_removed = 0;
+  /// Flips made after the node moves (the tet count changes by one per flip).
+  TetFlipReport flips;
   /// The interior/bone-surface node optimization (quality before/after it),
   /// and the second round with skin nodes sliding (passes = 0 if not run).
   InteriorSmoothingReport smoothing, skin_smoothing;

@@ -1,0 +1,36 @@
+#pragma once
+// Removal of flat or inverted boundary caps: a tet whose four nodes lie on the
+// outer surface and two of whose faces are on the boundary spans a ridge of
+// the surface. Where a shape turns that ridge from convex to concave (a
+// crease deepening at the crotch, the armpit, under the breast), the tet
+// flattens and then inverts, and no node move that keeps the nodes on the
+// surface can help. Removing it flips the boundary edge: the faces (a,b,c),
+// (a,b,d) give way to (a,c,d), (b,c,d), every node stays where it is and on
+// the surface, and the boundary follows the concave surface more closely.
+#include <vector>
+
+#include "sflsh/core/types.hpp"
+#include "sflsh/mesh/tet_mesh.hpp"
+
+namespace sflsh {
+
+struct BoundaryCapReport {
+  int removed = 0;  ///< tets removed
+  /// Caps still below the floor or inverted that could not be removed
+  /// (removal would make an edge or a node non-manifold or orphan a node).
+  int kept_bad = 0;
+};
+
+/// Removes, repeatedly until none is left, every tet of `mesh` whose four
+/// nodes have `on_surface[n] != 0` (#N flags), exactly two of whose faces are
+/// boundary faces, and whose smallest dihedral angle is below `floor_deg`
+/// (deg) or whose signed volume is <= 0, provided the removal keeps the
+/// boundary 2-manifold: the edge (c,d) opposite the shared boundary edge
+/// (a,b) must not already be a boundary edge, and every node must keep at
+/// least one tet. `kept` (#T' indices into the input's tets, in order)
+/// receives the surviving tets, so per-tet fields can follow. Nodes are not
+/// moved or renumbered. Deterministic (lowest tet index first).
+BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept = nullptr);
+
+}  // namespace sflsh

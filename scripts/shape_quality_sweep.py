@@ -1,0 +1,116 @@
+#!/usr/bin/python3
+"""Shaped-mesh quality over the shape space (slow check; issue 14).
+
+Runs the shape stage's geometry (shape_volume, default thickness map) on
+  * the procedural body: beta = 0, 32 corners of [-3, 3]^10 (every sign pattern of
+    the first 4 components, the others at +-3 alternating, both phases), each
+    direction alone at +-3, and 100 uniform random draws (seed 2026);
+  * the MakeHuman body (if ../shared/data/makehuman exists; converted into a
+    temporary folder with data_tools/makehuman_to_smpl.py): beta = 0, the same 32
+    corners, every shape direction alone at +-3, and the 12 MakeHuman targets;
+and writes scripts/results/shape_quality.md: per shape the min dihedral angle, the
+number of inverted tets, tets below 8 deg, skin caps removed and the time. Every
+shape must reach >= 8 deg with no inverted tet; the exit status is 1 otherwise.
+
+Usage: /usr/bin/python3 scripts/shape_quality_sweep.py [--build build] [--random 100]
+       [--models procedural,makehuman] [--shared ../shared] [--out scripts/results/shape_quality.md]
+Template stages come from the precompute cache (~/.cache/sflsh; built on first use).
+"""
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def run_sweep(binary, model, random, betas_csv=None):
+    env = dict(os.environ)
+    env.update(SFLSH_SWEEP_MODEL=model, SFLSH_SWEEP_RANDOM=str(random), SFLSH_SWEEP_DIRECTIONS="1",
+               SFLSH_SWEEP_CORNERS="32")
+    if betas_csv:
+        env["SFLSH_SWEEP_BETAS"] = betas_csv
+    t0 = time.time()
+    p = subprocess.run([binary, "--gtest_also_run_disabled_tests", "--gtest_filter=ShapeQualitySweep.*"],
+                       env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    rows = []
+    for line in p.stdout.splitlines():
+        if line.startswith("SWEEP|"):
+            rows.append(line.split("|")[1:])
+    if not rows:
+        sys.exit("shape_quality_sweep: no result lines from %s for %s:\n%s" % (binary, model, p.stdout[-3000:]))
+    return rows, time.time() - t0
+
+
+def ok(row):
+    return row[1] != "failed" and float(row[1]) >= 8.0 and row[2] == "0"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--random", type=int, default=100)
+    ap.add_argument("--models", default="procedural,makehuman")
+    ap.add_argument("--shared", default=os.environ.get("SFLSH_SHARED_DIR", os.path.join(ROOT, "..", "shared")))
+    ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results", "shape_quality.md"))
+    a = ap.parse_args()
+    all_ok = True
+    binary = os.path.join(a.build, "test_precompute")
+    if not os.path.exists(binary):
+        sys.exit("shape_quality_sweep: %s not found (build it: scripts/build.sh --target test_precompute)" % binary)
+
+    sections = []
+    for model in a.models.split(","):
+        if model == "procedural":
+            rows, wall = run_sweep(binary, "procedural", a.random)
+            sections.append(("procedural body (%d shapes: zero, 32 corners, 20 single directions, %d random)"
+                             % (len(rows), a.random), rows, wall))
+        elif model == "makehuman":
+            mh = os.path.join(a.shared, "data", "makehuman")
+            if not os.path.isdir(mh):
+                print("shape_quality_sweep: %s absent, MakeHuman body skipped" % mh)
+                continue
+            with tempfile.TemporaryDirectory() as tmp:
+                h5, csv = os.path.join(tmp, "mh.h5"), os.path.join(tmp, "mh_targets.csv")
+                subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "data_tools", "makehuman_to_smpl.py"), mh, h5,
+                                "--target-betas", csv], check=True, stdout=subprocess.DEVNULL)
+                rows, wall = run_sweep(binary, h5, 0, csv)
+            sections.append(("MakeHuman body (%d shapes: zero, 32 corners, 20 single directions, 12 targets)"
+                             % len(rows), rows, wall))
+        else:
+            sys.exit("shape_quality_sweep: --models: unknown model '%s' (expected procedural, makehuman)" % model)
+        all_ok = write(a.out, sections)  # after every body, so a long run leaves what it measured
+    print("shape_quality_sweep: wrote %s (%s)" % (a.out, "all shapes meet the bar" if all_ok else "SOME SHAPES FAIL"))
+    return 0 if all_ok else 1
+
+
+def write(path, sections):
+    all_ok = True
+    out = ["# Shaped-mesh quality over the shape space", "",
+           "Written by `scripts/shape_quality_sweep.py` (%s). Bar: every shape min dihedral >= 8 deg, 0 inverted."
+           % time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+           "Time = shape_volume (geometry of the shape stage) per shape, wall, on a shared 2-core machine.", ""]
+    for title, rows, wall in sections:
+        good = sum(ok(r) for r in rows)
+        worst = min((float(r[1]) for r in rows if r[1] != "failed"), default=float("nan"))
+        times = [float(r[5]) for r in rows]
+        out += ["## " + title, "",
+                "%d of %d meet the bar; worst min dihedral %.3f deg; time per shape median %.1f s, max %.1f s; "
+                "sweep wall %.0f s." % (good, len(rows), worst, sorted(times)[len(times) // 2], max(times), wall), "",
+                "| shape | min dihedral (deg) | inverted | tets < 8 deg | skin caps removed | time (s) | ok |",
+                "|---|---|---|---|---|---|---|"]
+        out += ["| %s | %s | %s | %s | %s | %s | %s |" % (r[0], r[1], r[2], r[3], r[4], r[5], "yes" if ok(r) else "**no**")
+                for r in rows]
+        out.append("")
+        all_ok = all_ok and good == len(rows)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path + ".partial", "w") as f:
+        f.write("\n".join(out))
+    os.replace(path + ".partial", path)
+    return all_ok
+
+
+if __name__ == "__main__":
+    sys.exit(main())

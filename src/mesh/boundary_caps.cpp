@@ -1,0 +1,111 @@
+#include "sflsh/mesh/boundary_caps.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/mesh/tet_quality.hpp"
+
+namespace sflsh {
+namespace {
+
+using Face = std::array<int, 3>;
+
+Face sorted_face(int a, int b, int c) {
+  Face f{a, b, c};
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
+// Face i of tet t is the one opposite its node i.
+Face tet_face(const Tets& e, int t, int i) {
+  int v[3], m = 0;
+  for (int j = 0; j < 4; ++j)
+    if (j != i) v[m++] = e(t, j);
+  return sorted_face(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept) {
+  const int N = mesh.num_nodes(), T = mesh.num_elements();
+  require(int(on_surface.size()) == N, "remove_bad_boundary_caps: ", on_surface.size(), " surface flags for ", N,
+          " nodes");
+  BoundaryCapReport rep;
+  std::vector<char> alive(T, 1);
+  std::map<Face, int> face_count;  // faces of the alive tets
+  std::vector<int> node_tets(N, 0);
+  for (int t = 0; t < T; ++t)
+    for (int i = 0; i < 4; ++i) {
+      ++face_count[tet_face(mesh.elements, t, i)];
+      ++node_tets[mesh.elements(t, i)];
+    }
+  // Boundary faces per edge (a < b), kept up to date as tets go.
+  std::map<std::pair<int, int>, int> edge_boundary;
+  auto edge = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+  auto add_face = [&](const Face& f, int s) {
+    edge_boundary[edge(f[0], f[1])] += s;
+    edge_boundary[edge(f[1], f[2])] += s;
+    edge_boundary[edge(f[0], f[2])] += s;
+  };
+  for (const auto& [f, c] : face_count)
+    if (c == 1) add_face(f, 1);
+
+  auto is_bad = [&](int t) {
+    const TetQuality q = tet_quality(mesh, t);
+    return !(q.signed_volume > 0) || q.min_dihedral_deg < floor_deg;
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int t = 0; t < T; ++t) {
+      if (!alive[t]) continue;
+      bool all_surface = true;
+      for (int i = 0; i < 4; ++i) all_surface = all_surface && on_surface[mesh.elements(t, i)];
+      if (!all_surface || !is_bad(t)) continue;
+      int boundary[4], nb = 0;
+      for (int i = 0; i < 4; ++i) {
+        boundary[i] = face_count[tet_face(mesh.elements, t, i)] == 1;
+        nb += boundary[i];
+      }
+      if (nb != 2) continue;
+      // The boundary faces are opposite c and d; they share edge (a, b).
+      int cd[2], nc = 0;
+      for (int i = 0; i < 4; ++i)
+        if (boundary[i]) cd[nc++] = mesh.elements(t, i);
+      bool ok = edge_boundary[edge(cd[0], cd[1])] == 0;
+      for (int i = 0; i < 4; ++i) ok = ok && node_tets[mesh.elements(t, i)] > 1;
+      if (!ok) continue;
+      alive[t] = 0;
+      ++rep.removed;
+      changed = true;
+      for (int i = 0; i < 4; ++i) {
+        const Face f = tet_face(mesh.elements, t, i);
+        if (boundary[i]) {
+          add_face(f, -1);  // was boundary, now gone
+          face_count.erase(f);
+        } else {
+          face_count[f] = 1;  // now boundary
+          add_face(f, 1);
+        }
+        --node_tets[mesh.elements(t, i)];
+      }
+    }
+  }
+  std::vector<int> keep;
+  for (int t = 0; t < T; ++t)
+    if (alive[t]) keep.push_back(t);
+  for (int t : keep) {
+    bool all_surface = true;
+    for (int i = 0; i < 4; ++i) all_surface = all_surface && on_surface[mesh.elements(t, i)];
+    rep.kept_bad += all_surface && is_bad(t);
+  }
+  Tets e(keep.size(), 4);
+  for (size_t i = 0; i < keep.size(); ++i) e.row(i) = mesh.elements.row(keep[i]);
+  mesh.elements = e;
+  if (kept) *kept = keep;
+  return rep;
+}
+
+}  // namespace sflsh

@@ -1,0 +1,175 @@
+#include "sflsh/mesh/tet_flips.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+
+#include "sflsh/mesh/tet_quality.hpp"
+
+namespace sflsh {
+namespace {
+
+using Face = std::array<int, 3>;
+using Tet = std::array<int, 4>;
+
+Face key(int a, int b, int c) {
+  Face f{a, b, c};
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
+TetQuality quality(const Points& x, const Tet& t) {
+  return tet_quality(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose(),
+                     x.row(t[3]).transpose());
+}
+
+// Orients the candidate tets alike (all positive if the flip is valid);
+// returns their smallest dihedral angle, or -1 if any is degenerate or they
+// disagree in orientation.
+double orient_and_rate(const Points& x, std::vector<Tet>& tets) {
+  double worst = 180;
+  int sign = 0;
+  for (Tet& t : tets) {
+    const double v = quality(x, t).signed_volume;
+    const int s = v > 0 ? 1 : (v < 0 ? -1 : 0);
+    if (s == 0 || (sign != 0 && s != sign)) return -1;
+    sign = s;
+  }
+  for (Tet& t : tets) {
+    if (sign < 0) std::swap(t[2], t[3]);
+    worst = std::min(worst, quality(x, t).min_dihedral_deg);
+  }
+  return worst;
+}
+
+// The new tets fill exactly the old ones (the flip is geometric, not just
+// combinatorial): equal total volume, relative to the old one.
+bool same_volume(const Points& x, const std::vector<Tet>& fresh, const std::vector<Tet>& old) {
+  double a = 0, b = 0;
+  for (const Tet& t : fresh) a += std::abs(quality(x, t).signed_volume);
+  for (const Tet& t : old) b += quality(x, t).signed_volume;
+  return b > 0 && std::abs(a - b) <= 1e-9 * b;
+}
+
+}  // namespace
+
+TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
+  TetFlipReport rep;
+  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
+  std::vector<Tet> tets(mesh.num_elements());
+  std::vector<int> origin(mesh.num_elements());
+  std::vector<char> alive(tets.size(), 1);
+  for (int t = 0; t < mesh.num_elements(); ++t) {
+    for (int i = 0; i < 4; ++i) tets[t][i] = mesh.elements(t, i);
+    origin[t] = t;
+  }
+  std::map<Face, std::vector<int>> face_tets;
+  std::map<std::pair<int, int>, std::vector<int>> edge_tets;
+  auto edge = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+  auto link = [&](int t, bool add) {
+    const Tet& v = tets[t];
+    for (int i = 0; i < 4; ++i) {
+      auto& f = face_tets[key(v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4])];
+      if (add) f.push_back(t); else f.erase(std::find(f.begin(), f.end(), t));
+      for (int j = i + 1; j < 4; ++j) {
+        auto& e = edge_tets[edge(v[i], v[j])];
+        if (add) e.push_back(t); else e.erase(std::find(e.begin(), e.end(), t));
+      }
+    }
+  };
+  for (size_t t = 0; t < tets.size(); ++t) link(int(t), true);
+  const Points& x = mesh.nodes;
+  auto rate = [&](int t) { return quality(x, tets[t]).min_dihedral_deg; };
+  auto replace = [&](const std::vector<int>& old, const std::vector<Tet>& fresh) {
+    for (int t : old) link(t, false), alive[t] = 0;
+    for (const Tet& n : fresh) {
+      tets.push_back(n);
+      alive.push_back(1);
+      origin.push_back(origin[old[0]]);
+      link(int(tets.size()) - 1, true);
+    }
+  };
+
+  for (int round = 0; round < rounds; ++round) {
+    int made = 0;
+    const size_t count = tets.size();
+    for (size_t t = 0; t < count; ++t) {
+      if (!alive[t] || rate(int(t)) >= target_deg) continue;
+      bool done = false;
+      // 2-3 across each interior face.
+      for (int i = 0; i < 4 && !done; ++i) {
+        const Tet& v = tets[t];
+        const int a = v[i];
+        const Face f = key(v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4]);
+        const std::vector<int>& ft = face_tets[f];
+        if (ft.size() != 2) continue;
+        const int u = ft[0] == int(t) ? ft[1] : ft[0];
+        int e = -1;
+        for (int k = 0; k < 4; ++k)
+          if (std::find(f.begin(), f.end(), tets[u][k]) == f.end()) e = tets[u][k];
+        if (!edge_tets[edge(a, e)].empty()) continue;  // the new edge exists already
+        std::vector<Tet> fresh = {{f[0], f[1], a, e}, {f[1], f[2], a, e}, {f[2], f[0], a, e}};
+        const double before = std::min(rate(int(t)), rate(u));
+        if (orient_and_rate(x, fresh) > before + 1e-9 && same_volume(x, fresh, {tets[t], tets[u]})) {
+          replace({int(t), u}, fresh);
+          ++rep.flips_2_3;
+          done = true;
+        }
+      }
+      // 3-2 around each edge with a closed ring of three tets.
+      for (int i = 0; i < 4 && !done; ++i)
+        for (int j = i + 1; j < 4 && !done; ++j) {
+          const int a = tets[t][i], b = tets[t][j];
+          const std::vector<int> ring = edge_tets[edge(a, b)];
+          if (ring.size() != 3) continue;
+          std::vector<int> others;
+          for (int r : ring)
+            for (int k = 0; k < 4; ++k)
+              if (tets[r][k] != a && tets[r][k] != b &&
+                  std::find(others.begin(), others.end(), tets[r][k]) == others.end())
+                others.push_back(tets[r][k]);
+          if (others.size() != 3) continue;
+          bool closed = true;  // every face (a, b, c) shared by two tets of the ring
+          for (int c : others) closed = closed && face_tets[key(a, b, c)].size() == 2;
+          if (!closed || !face_tets[key(others[0], others[1], others[2])].empty()) continue;
+          std::vector<Tet> fresh = {{others[0], others[1], others[2], a}, {others[0], others[1], others[2], b}};
+          // The two must lie on opposite sides of the new face: orient each on its own.
+          double worst = 180;
+          bool valid = true;
+          for (Tet& n : fresh) {
+            const double v = quality(x, n).signed_volume;
+            if (v == 0) valid = false;
+            if (v < 0) std::swap(n[2], n[3]);
+            worst = std::min(worst, quality(x, n).min_dihedral_deg);
+          }
+          const double before = std::min({rate(ring[0]), rate(ring[1]), rate(ring[2])});
+          // Opposite sides: a and b on different sides of the face (others).
+          const Vec3 p0 = x.row(others[0]).transpose(), p1 = x.row(others[1]).transpose(),
+                     p2 = x.row(others[2]).transpose();
+          const Vec3 nrm = (p1 - p0).cross(p2 - p0);
+          const double sa = nrm.dot(x.row(a).transpose() - p0), sb = nrm.dot(x.row(b).transpose() - p0);
+          if (valid && sa * sb < 0 && worst > before + 1e-9 &&
+              same_volume(x, fresh, {tets[ring[0]], tets[ring[1]], tets[ring[2]]})) {
+            replace(ring, fresh);
+            ++rep.flips_3_2;
+            done = true;
+          }
+        }
+      made += done;
+    }
+    if (made == 0) break;
+  }
+  std::vector<int> keep;
+  for (size_t t = 0; t < tets.size(); ++t)
+    if (alive[t]) keep.push_back(int(t));
+  mesh.elements.resize(keep.size(), 4);
+  if (parent) parent->resize(keep.size());
+  for (size_t i = 0; i < keep.size(); ++i) {
+    for (int k = 0; k < 4; ++k) mesh.elements(i, k) = tets[keep[i]][k];
+    if (parent) (*parent)[i] = origin[keep[i]];
+  }
+  rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
+  return rep;
+}
+
+}  // namespace sflsh

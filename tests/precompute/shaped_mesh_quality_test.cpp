@@ -1,0 +1,81 @@
+// Shaped-mesh quality on a few extreme shapes (fast; the full sweep over the shape space is
+// scripts/shape_quality_sweep.py): the shape stage's geometry (shape_volume, default thickness
+// map) on a coarse mesh must keep every tet's smallest dihedral angle >= 8 deg with none
+// inverted. Procedural body: the all -3 and all +3 corners of [-3, 3]^10 and two mixed ones.
+// MakeHuman body (skips when ../shared/data/makehuman is absent): the two targets whose folds
+// the pipeline could not undo before (male maximum weight: skin caps turned inside out under
+// the arm and at the crotch; male minimum muscle: node paths folded in the legs) and the
+// minimum height (calves shortened by decimetres).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "../test_support.hpp"
+#include "sflsh/body/body_model_io.hpp"
+#include "sflsh/precompute/precompute.hpp"
+#include "sflsh/volume/shape_volume.hpp"
+
+using namespace sflsh;
+
+namespace {
+
+PrecomputeOptions coarse() {
+  PrecomputeOptions o;  // the coarse mesh of the other precompute tests
+  o.template_stage.mesh.cell_size = 0.08;
+  o.template_stage.mesh.facet_size = 0.06;
+  o.template_stage.mesh.facet_distance = 0.004;
+  o.bbw.show_progress = false;
+  return o;
+}
+
+void expect_quality(const TemplateVolume& tv, const BodyModel& model, const std::string& name, const VecX& betas) {
+  const ShapedVolume s = shape_volume(tv, model, betas, ThicknessMap::defaults());
+  const TetQualityReport& q = s.report.quality;
+  std::printf("%s: min dihedral %.3f deg, %d inverted, %d caps removed, %d+%d flips, %.1f s\n", name.c_str(),
+              q.min_dihedral_deg, q.num_inverted, s.report.caps_removed, s.report.flips.flips_2_3,
+              s.report.flips.flips_3_2, s.report.seconds);
+  EXPECT_GE(q.min_dihedral_deg, 8.0) << name;
+  EXPECT_EQ(q.num_inverted, 0) << name;
+  EXPECT_EQ(s.avatar.tet_region.size(), s.avatar.tet.num_elements()) << name;
+}
+
+TEST(ShapedMeshQuality, ProceduralBodyExtremeCorners) {
+  const BodyModel model = load_body_model("procedural");
+  const TemplateVolume tv = cached_template_volume(model, coarse());
+  const int B = model.num_betas(), D = std::min(B, 10);
+  VecX lo = VecX::Zero(B), hi = VecX::Zero(B), alt = VecX::Zero(B), alt2 = VecX::Zero(B);
+  for (int d = 0; d < D; ++d) {
+    lo[d] = -3, hi[d] = 3;
+    alt[d] = d % 2 ? -3 : 3, alt2[d] = d % 2 ? 3 : -3;
+  }
+  expect_quality(tv, model, "all -3", lo);
+  expect_quality(tv, model, "all +3", hi);
+  expect_quality(tv, model, "+-+-...", alt);
+  expect_quality(tv, model, "-+-+...", alt2);
+}
+
+TEST(ShapedMeshQuality, MakeHumanHardestTargets) {
+  const std::string folder = test::shared_data("makehuman");
+  if (folder.empty()) GTEST_SKIP() << "../shared/data/makehuman is absent (the MakeHuman base human); skipping";
+  test::TempDir dir;
+  std::string log;
+  ASSERT_EQ(test::run_command("/usr/bin/python3 " + test::source_dir() + "/data_tools/makehuman_to_smpl.py " +
+                                  folder + " " + dir.file("mh.h5"),
+                              &log),
+            0)
+      << log;
+  const BodyModel model = load_body_model(dir.file("mh.h5"));
+  const TemplateVolume tv = cached_template_volume(model, coarse());
+  const int B = model.num_betas();
+  // Rows of makehuman_to_smpl.py --target-betas (beta = +-3 in the directions that make the target).
+  auto betas = [&](std::vector<double> v) {
+    VecX b = VecX::Zero(B);
+    for (int i = 0; i < std::min<int>(B, v.size()); ++i) b[i] = v[i];
+    return b;
+  };
+  expect_quality(tv, model, "male max weight", betas({3, 0, 0, -3, 0, 3, 0, -3, 0, 0}));
+  expect_quality(tv, model, "male min muscle", betas({0, -3, 0, 0, 3, 0, 3, 0, -3, 0}));
+  expect_quality(tv, model, "min height", betas({0, 0, -3, 0, 0, 0, 0, 0, 0, 3}));
+}
+
+}  // namespace
