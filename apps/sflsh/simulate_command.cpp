@@ -34,7 +34,7 @@ struct SimulateArgs {
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
   long inject_nan_at_step = 0;  // test only (hidden option)
-  bool line_search = false, use_file_betas = false, start_at_rest = false, volume_per_tet = false;
+  bool line_search = false, use_file_betas = false, start_at_rest = false, mean_dilatation = false;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
   double tracking_tolerance_mm = 20;
   bool strict = false;
@@ -112,7 +112,7 @@ void run_simulate(const SimulateArgs& a) {
   o.sim.newton.max_rotation_step = a.max_rotation_step;
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
-  o.sim.mean_dilatation = !a.volume_per_tet;
+  o.sim.mean_dilatation = a.mean_dilatation;
   require(!a.seconds_given || (std::isfinite(a.seconds) && a.seconds > 0),
           "--seconds must be a positive number of seconds, got ", a.seconds);
   require(std::isfinite(a.output_fps) && a.output_fps > 0, "--output-fps must be positive, got ", a.output_fps);
@@ -221,8 +221,8 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   auto* seconds = cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
   cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
   cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
-  cmd->add_flag("--volume-per-tet", a->volume_per_tet,
-                "Constrain every tet's volume change on its own (no mean dilatation per handle cell; locks the subspace)");
+  cmd->add_flag("--mean-dilatation", a->mean_dilatation,
+                "Average the small-strain volume change per handle cell (B-bar against the subspace's locking; issue 13)");
   cmd->add_option("--max-rotation-step", a->max_rotation_step,
                   "Largest bone rotation per Newton iteration (rad); larger steps are scaled down as a whole "
                   "(counted as damped); <= 0: no cap")

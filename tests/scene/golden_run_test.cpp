@@ -85,7 +85,11 @@ void expect_golden(const char* name, const Fingerprint& f, const Fingerprint& go
                                                      << golden.joints_sum;
   EXPECT_TRUE(near(f.joints_weighted, golden.joints_weighted))
       << name << " joints_weighted " << f.joints_weighted << " vs " << golden.joints_weighted;
-  EXPECT_TRUE(near(f.energy_sum, golden.energy_sum)) << name << " energy_sum " << f.energy_sum << " vs "
+  // The energy sum (~1.5e3 J over every step, terms that nearly cancel) moves
+  // by ~3e-11 relative when the Hessian's sums are reassociated (issue 13's
+  // exact speed-ups), while z and the joints stay within 1e-12.
+  auto near_energy = [](double a, double b) { return std::abs(a - b) <= 1e-10 * std::max(1.0, std::abs(b)); };
+  EXPECT_TRUE(near_energy(f.energy_sum, golden.energy_sum)) << name << " energy_sum " << f.energy_sum << " vs "
                                                      << golden.energy_sum;
 }
 

@@ -402,7 +402,9 @@ TEST(Model, AWorldFixedAnchorStaysWhereTheSceneHasIt) {
   in.bodies = {{sim.state().bones, {}}};
   in.frames["anchor"].pose.translation() = anchor;
   StepReport rep;
-  for (int i = 0; i < 600; ++i) rep = sim.step(in);
+  // Nothing damps the swing but backward Euler itself (the flesh rings for a
+  // few seconds after the 4 m pull): 20 s lets it settle well below 1 N.
+  for (int i = 0; i < 1200; ++i) rep = sim.step(in);
   EXPECT_LT((sim.joints().row(0).transpose() - anchor).norm(), 1e-3);
   EXPECT_EQ(in.frames.at("anchor").pose.translation(), anchor);
   // The report hook: the spring's force on the body, ~0 at rest.

@@ -134,7 +134,8 @@ Configuration run_dynamic(int steps) {
   o.bones_dynamic = true;
   o.mean_dilatation = false;  // the golden values were recorded with every tet's own volume change
   const auto a = small_avatar(false);
-  const SkeletonTermsOptions skeleton;
+  SkeletonTermsOptions skeleton;
+  skeleton.spring_inertia = SkeletonTermsOptions::SpringInertia::Segments;  // the springs of that time
   Simulator sim(avatar_model(a, o, &skeleton));
   for (int i = 1; i <= steps; ++i) {
     const StepReport rep = sim.step(test::synthetic_motion(*a, i * o.h));

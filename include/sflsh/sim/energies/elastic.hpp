@@ -31,7 +31,7 @@ class ElasticTerm : public EnergyTerm {
   /// Ψ₂ over cells of tets (linearized_stiffness.hpp): the subspace no longer
   /// locks on the near-incompressible tissue (bench: rel_err 0.33 → 0.20 on jump).
   explicit ElasticTerm(const Avatar& avatar, bool project_psd = true, bool exact_quadratic = true,
-                       bool mean_dilatation = true);
+                       bool mean_dilatation = false);
   std::string name() const override { return "elastic"; }
   BodyBlocks blocks() const override { return BodyBlocks::Soft; }
   /// Scratch of the Hessian assembly (kept in the State: no allocation per step).
@@ -57,7 +57,7 @@ class ElasticTerm : public EnergyTerm {
   int num_reduced_ = 0;
   bool project_psd_ = true;
   bool exact_quadratic_ = true;
-  bool mean_dilatation_ = true;
+  bool mean_dilatation_ = false;
 };
 
 /// Frame of tet t from avatar.tet_frames (row-major 3x3), or the identity when
