@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Fuzz the readers with libFuzzer + AddressSanitizer + UBSan.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default: 60 s each, every target)
+#   FUZZ_RUNS=1000000 scripts/fuzz.sh 1800 ... stops a target at 10^6 executions or 30 min,
+#   whichever comes first (the reliability issue's budget per target).
+#   FUZZ_TIMEOUT=S sets the per-input time limit (default 10 s); on a machine whose other jobs
+#   starve the fuzzer, a 10 s wall-clock limit reports false timeouts (replay them to check).
 # Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5 material
 # scene_yaml mesh stream pose_file control_message.
 # Needs clang and compiler-rt (Debian: clang libclang-rt-14-dev; scripts/setup.sh).
@@ -88,8 +92,8 @@ run_target() {
   before=$(ls "$OUT/crashes/$t" | wc -l)
   local status=0
   (cd "$OUT" && ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" LSAN_OPTIONS="suppressions=$ROOT/fuzz/lsan.supp" \
-     "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" \
-     -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
+     "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" ${FUZZ_RUNS:+-runs="$FUZZ_RUNS"} \
+     -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
      -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$OUT/crashes/$t" "${regressions[@]}" \
      > "$log" 2>&1) || status=$?
   local execs cov found
