@@ -18,6 +18,8 @@ namespace {
 struct BenchArgs {
   bool quick = false, no_cache = false, peer = true;
   std::string motion = "builtin:jump", out = "bench", model = "procedural", betas, handles, cache_dir;
+  std::vector<std::string> only;
+  int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
   double seconds = 0;
   bool seconds_given = false;
 };
@@ -34,6 +36,10 @@ void run_bench(const BenchArgs& a) {
   o.motion = a.motion;
   o.seconds = a.seconds;
   o.model = a.model;
+  o.only = a.only;
+  require(a.inertia_samples_per_cell >= 0 && a.inertia_samples_per_cell <= 1000,
+          "--inertia-samples-per-cell must be in [0, 1000], got ", a.inertia_samples_per_cell);
+  o.precompute.inertia_samples_per_cell = a.inertia_samples_per_cell;
   if (!a.betas.empty()) o.betas = parse_betas(a.betas);
   if (!a.handles.empty()) {
     VecX k;
@@ -82,6 +88,13 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
   cmd->add_option("--betas", a->betas, "Body shape b0,b1,...");
   cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
+  cmd->add_option("--only", a->only,
+                  "Run only the variants whose label contains one of these strings (the reference, the default "
+                  "and skinning always run), e.g. --only lumped,mass-fitted")
+      ->delimiter(',');
+  cmd->add_option("--inertia-samples-per-cell", a->inertia_samples_per_cell,
+                  "Inertia cubature of every avatar built (as precompute --inertia-samples-per-cell)")
+      ->capture_default_str();
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
   cmd->add_flag("--peer,!--no-peer", a->peer, "Run the Bullet 3 deformable-FEM peer rows (default on)");
   cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.md, bench.svg)")->capture_default_str();

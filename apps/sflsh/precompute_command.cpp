@@ -31,6 +31,7 @@ struct PrecomputeArgs {
   std::string betas;
   int handles = 64;
   int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
+  int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
   bool no_fit_cubature = false;
   std::string handles_file, thickness_map, out = "avatar.h5", batch, out_dir, cache_dir;
   bool no_cache = false, template_only = false, dry_run = false;
@@ -47,6 +48,9 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
           "--elastic-samples-per-cell must be in [1, 1000], got ", a.elastic_samples_per_cell);
   o.elastic_samples_per_cell = a.elastic_samples_per_cell;
   o.fit_elastic_cubature = !a.no_fit_cubature;
+  require(a.inertia_samples_per_cell >= 0 && a.inertia_samples_per_cell <= 1000,
+          "--inertia-samples-per-cell must be in [0, 1000], got ", a.inertia_samples_per_cell);
+  o.inertia_samples_per_cell = a.inertia_samples_per_cell;
   if (!a.handles_file.empty()) o.handle_positions = read_handles_file(a.handles_file);
   if (!a.thickness_map.empty()) o.thickness = read_thickness_map(a.thickness_map);
   if (!a.no_cache) o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
@@ -78,7 +82,8 @@ std::vector<std::string> worker_command(const PrecomputeArgs& a, const Precomput
                                         const std::string& manifest) {
   std::vector<std::string> c = {self_executable(), "-q", "precompute", "--model", a.model, "--handles",
                                 std::to_string(a.handles), "--elastic-samples-per-cell",
-                                std::to_string(a.elastic_samples_per_cell), "--cache-dir", o.cache_dir};
+                                std::to_string(a.elastic_samples_per_cell), "--inertia-samples-per-cell",
+                                std::to_string(a.inertia_samples_per_cell), "--cache-dir", o.cache_dir};
   if (a.no_fit_cubature) c.push_back("--no-fit-cubature");
   for (const auto& [flag, value] : {std::pair<const char*, const std::string*>{"--handles-file", &a.handles_file},
                                     {"--thickness-map", &a.thickness_map}})
@@ -276,6 +281,10 @@ const CommandRegistrar reg(20, [](CLI::App& app) {
   cmd->add_option("--handles", a->handles, "Number of control-point handles K (3K reduced DoFs)")->capture_default_str();
   cmd->add_option("--elastic-samples-per-cell", a->elastic_samples_per_cell,
                   "Elastic cubature candidates per cell of dominant weight")
+      ->capture_default_str();
+  cmd->add_option("--inertia-samples-per-cell", a->inertia_samples_per_cell,
+                  "Inertia cubature: candidate nodes per cell, weights fitted to the lumped mass matrix "
+                  "(0 = one data-oblivious sample per handle)")
       ->capture_default_str();
   cmd->add_flag("--no-fit-cubature", a->no_fit_cubature,
                 "Keep the stratified elastic cubature's volume weights (no stiffness fit)");

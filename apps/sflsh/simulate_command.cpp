@@ -34,7 +34,8 @@ struct SimulateArgs {
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
   long inject_nan_at_step = 0;  // test only (hidden option)
-  bool line_search = false, use_file_betas = false, start_at_rest = false, mean_dilatation = false;
+  bool line_search = false, use_file_betas = false, start_at_rest = false,
+       mean_dilatation = SimulatorOptions().mean_dilatation;
   bool seconds_given = false;  // --seconds on the command line (0 there is an error, not "the motion's")
   double tracking_tolerance_mm = 20;
   bool strict = false;
@@ -221,8 +222,9 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   auto* seconds = cmd->add_option("--seconds", a->seconds, "Simulated duration (default: the motion's, 5 s for built-ins)");
   cmd->add_option("--newton-iters", a->newton_iters, "Newton iterations per step")->capture_default_str();
   cmd->add_flag("--line-search", a->line_search, "Backtracking line search on the step objective");
-  cmd->add_flag("--mean-dilatation", a->mean_dilatation,
-                "Average the small-strain volume change per handle cell (B-bar against the subspace's locking; issue 13)");
+  cmd->add_flag("--mean-dilatation,!--volume-per-tet", a->mean_dilatation,
+                "Average the small-strain volume change per handle cell (B-bar against the subspace's locking; "
+                "the default), or integrate every tet's own (--volume-per-tet)");
   cmd->add_option("--max-rotation-step", a->max_rotation_step,
                   "Largest bone rotation per Newton iteration (rad); larger steps are scaled down as a whole "
                   "(counted as damped); <= 0: no cap")

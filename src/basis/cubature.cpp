@@ -5,6 +5,7 @@
 
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
+#include "farthest_points.hpp"
 
 namespace sflsh::basis {
 
@@ -126,18 +127,7 @@ Cubature stratified_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<doub
     }
     // Farthest-point sampling from the cell's centroid-nearest tet.
     const int m = std::min<int>(samples_per_cell, int(tets.size()));
-    const Vec3 mid = centroid.colwise().mean();
-    VecX dist = (centroid.rowwise() - mid.transpose()).rowwise().squaredNorm();
-    int first = 0;
-    dist.minCoeff(&first);
-    std::vector<int> chosen{first};
-    dist = (centroid.rowwise() - centroid.row(first)).rowwise().squaredNorm();
-    while (int(chosen.size()) < m) {
-      int next = 0;
-      dist.maxCoeff(&next);
-      chosen.push_back(next);
-      dist = dist.cwiseMin((centroid.rowwise() - centroid.row(next)).rowwise().squaredNorm());
-    }
+    const std::vector<int> chosen = farthest_points(centroid, m);
     for (int i : chosen) {
       elems.push_back(tets[i]);
       weights.push_back(cell_volume / m);

@@ -6,6 +6,7 @@
 
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
+#include "nonnegative_least_squares.hpp"
 
 namespace sflsh::basis {
 namespace {
@@ -76,27 +77,12 @@ Cubature stiffness_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatri
     A(rows, s) = kVolumeRowWeight / volume;
   }
 
-  // NNLS on the normal equations: min ½ cᵀQc − fᵀc, c ≥ 0, cyclic projected
-  // coordinate descent with an incrementally updated gradient g = Qc − f.
+  // NNLS on the normal equations: min ½ cᵀQc − fᵀc, c ≥ 0.
   const MatX Q = A.transpose() * A;
   const VecX f = A.transpose() * b;
   VecX c = candidates.weights;
-  VecX g = Q * c - f;
   const double initial_error = (A * c - b).head(rows).norm() / b.head(rows).norm();
-  int sweep = 0;
-  for (; sweep < 2000; ++sweep) {
-    double change = 0;
-    for (int s = 0; s < n; ++s) {
-      if (Q(s, s) <= 0) continue;
-      const double next = std::max(0.0, c[s] - g[s] / Q(s, s));
-      const double delta = next - c[s];
-      if (delta == 0) continue;
-      c[s] = next;
-      g += delta * Q.col(s);
-      change = std::max(change, std::abs(delta));
-    }
-    if (change <= 1e-10 * c.maxCoeff()) break;
-  }
+  const int sweep = nonnegative_least_squares(Q, f, c);
 
   Cubature out;
   std::vector<int> keep;

@@ -97,7 +97,7 @@ double reset_peak_rss_mib() {
 
 Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
                   int newton_iters, const std::string& label, bool bones_dynamic = false,
-                  bool mean_dilatation = false) {
+                  bool mean_dilatation = SimulatorOptions().mean_dilatation) {
   const double rss0 = reset_peak_rss_mib();
   SimulatorOptions o;
   o.mean_dilatation = mean_dilatation;
@@ -342,10 +342,18 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     r.speedup = r.ms_median > 0 ? ref_ms / r.ms_median : 0;
     rows.push_back(r);
   };
+  // --only: does the variant described by `what` run?
+  auto wanted = [&](const std::string& what) {
+    if (o.only.empty()) return true;
+    for (const std::string& s : o.only)
+      if (what.find(s) != std::string::npos) return true;
+    return false;
+  };
   auto reduced = [&](std::shared_ptr<const Avatar> a, int K, double dt, int iters, const std::string& what,
-                     bool is_default) {
+                     bool is_default, bool mean_dilatation = SimulatorOptions().mean_dilatation) {
     const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
-    const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label);
+    if (!is_default && !wanted(label)) return;
+    const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, false, mean_dilatation);
     add(tr, a, "reduced", label, K, dt, iters, is_default);
     BenchRow& r = rows.back();
     const double steps = double(tr.ms.size());
@@ -353,18 +361,18 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     r.ms_elastic = tr.ms_elastic / steps;
     r.ms_solve = tr.ms_solve / steps;
     r.peak_mib = tr.peak_mib;
-    r.dynamic_ms_median = percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true).ms, 0.5);
+    r.dynamic_ms_median =
+        percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true, mean_dilatation).ms, 0.5);
   };
   const int K = o.default_handles;
   // Handle counts at the default time step and cubature, one Newton step.
   for (size_t i = 0; i < avatars.size(); ++i)
     reduced(avatars[i], o.handle_counts[i], h, 1, o.handle_counts[i] == K ? "default" : "", o.handle_counts[i] == K);
   // Mean dilatation per handle cell (opt-in, against the subspace's volumetric locking; issue 13).
-  {
-    const std::string label = "K=" + std::to_string(K) + ", mean dilatation";
-    add(run_reduced(default_avatar, motion, o.seconds, h, 1, "reduced " + label, false, true), default_avatar, "reduced",
-        label, K, h, 1, false);
-  }
+  // Mean dilatation per handle cell (against the subspace's volumetric
+  // locking, issue 13) against every tet's own volume change, as before.
+  const bool md = SimulatorOptions().mean_dilatation;
+  reduced(default_avatar, K, h, 1, md ? "volume per tet (no mean dilatation, before)" : "mean dilatation", false, !md);
   // Time steps and Newton iterations around the default.
   for (double dt : o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0})
     reduced(default_avatar, K, dt, 1, "dt=1/" + std::to_string(int(std::lround(1.0 / dt))), false);
@@ -377,13 +385,14 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     po.handles = K;
     po.elastic_samples_per_cell = per_cell;
     po.fit_elastic_cubature = fit;
+    if (!wanted(what)) return;
     log_info("bench: shape stage for " + what);
     const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
     reduced(a, K, h, 1, what + " (" + std::to_string(a->elastic.size()) + " samples)", false);
   };
   // The basis before issue 13 (bones Dirichlet 0 in every QP), for its floor
   // and its simulation next to the default's.
-  {
+  if (wanted("bones Dirichlet 0") || wanted("bones depth-blended")) {
     PrecomputeOptions po = o.precompute;
     po.handles = K;
     po.bbw.bone_condition = po.bbw.bone_condition == basis::BoneCondition::Dirichlet ? basis::BoneCondition::DepthBlend
@@ -401,9 +410,9 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     cubature_variant(6, true, "6 samples/cell, fitted");
   }
   auto exact = std::make_shared<Avatar>(base);
-  exact->elastic = basis::full_cubature(exact->tet, exact->node_role, true);
+  if (wanted("elastic on all tets")) exact->elastic = basis::full_cubature(exact->tet, exact->node_role, true);
   reduced(exact, K, h, 1, "elastic on all tets", false);
-  if (!o.quick) {
+  if (!o.quick && wanted("elastic + inertia on all tets")) {
     auto exact_both = std::make_shared<Avatar>(*exact);
     exact_both->inertia = basis::full_cubature(exact->tet);
     reduced(exact_both, K, h, 1, "elastic + inertia on all tets", false);
@@ -414,13 +423,33 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   // reference onto span(W ⊗ I3) up to the posing nonlinearity.
   VecX tet_density(base.tet.num_elements());
   for (int t = 0; t < base.tet.num_elements(); ++t) tet_density[t] = tet_material(base, t).density;
-  auto lumped = std::make_shared<Avatar>(base);
-  lumped->inertia = basis::nodal_cubature(base.tet, tet_density, base.node_role);
-  reduced(lumped, K, h, 1, "inertia lumped at the nodes", false);
-  auto lumped_exact = std::make_shared<Avatar>(*exact);
-  lumped_exact->inertia = lumped->inertia;
-  reduced(lumped_exact, K, h, 1, "elastic on all tets + lumped nodal inertia", false);
-  for (bool reskin : o.peer ? std::vector<bool>{false, true} : std::vector<bool>{}) {
+  if (wanted("lumped")) {
+    auto lumped = std::make_shared<Avatar>(base);
+    lumped->inertia = basis::nodal_cubature(base.tet, tet_density, base.node_role);
+    reduced(lumped, K, h, 1, "inertia lumped at the nodes", false);
+    auto lumped_exact = std::make_shared<Avatar>(*exact);
+    lumped_exact->inertia = lumped->inertia;
+    reduced(lumped_exact, K, h, 1, "elastic on all tets + lumped nodal inertia", false);
+  }
+  // The other inertia cubature: the data-oblivious samples at the handles
+  // (before issue 13's fit), or the mass-fitted one if the default is that.
+  {
+    PrecomputeOptions po = o.precompute;
+    po.handles = K;
+    po.inertia_samples_per_cell = o.precompute.inertia_samples_per_cell > 0 ? 0 : 2;
+    const std::string what = po.inertia_samples_per_cell > 0 ? "inertia mass-fitted"
+                                                             : "inertia at the handles (data-oblivious, before)";
+    const bool before = po.inertia_samples_per_cell == 0 && SimulatorOptions().mean_dilatation;
+    const std::string both = "before issue 13's accuracy fixes (volume per tet, inertia at the handles)";
+    if (wanted(what) || (before && wanted(both))) {
+      log_info("bench: shape stage for " + what);
+      const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
+      if (wanted(what)) reduced(a, K, h, 1, what + " (" + std::to_string(a->inertia.size()) + " samples)", false);
+      // Both of issue 13's changes undone: the defaults before them.
+      if (before && wanted(both)) reduced(a, K, h, 1, both, false, false);
+    }
+  }
+  for (bool reskin : o.peer && wanted("Bullet") ? std::vector<bool>{false, true} : std::vector<bool>{}) {
     int iters = 0;
     long diverged = 0;
     const Trace tr = run_peer(default_avatar, motion, o.seconds, h, reskin, &iters, &diverged);

@@ -176,7 +176,9 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
   mo.parallel_groups = false;
   ModelBuilder mb(mo);
   const int body = mb.add_body({"avatar", avatar, false});
-  add_soft_tissue_terms(mb, body);
+  SoftTissueOptions so;
+  so.mean_dilatation = o.mean_dilatation;
+  add_soft_tissue_terms(mb, body, so);
   if (with_object) {
     SdfContactOptions co;
     co.stiffness = o.stiffness;

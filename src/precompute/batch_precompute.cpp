@@ -187,7 +187,9 @@ std::string key_prefix(const BodyModel& model, const PrecomputeOptions& o) {
   s << "|bbw," << o.bbw.max_iterations << ',' << o.bbw.pdas_iterations << ',' << o.bbw.multiplier_tolerance << ','
     << o.bbw.drop_tolerance << ',' << o.bbw.initial_radius_factor << ',' << o.bbw.max_border_columns << ','
     << int(o.bbw.bone_condition) << ',' << o.bbw.normalization_floor << ',' << o.bbw.kkt_tolerance << ',' << o.bbw.max_releases;
-  s << "|cubature," << o.elastic_samples_per_cell << ',' << o.fit_elastic_cubature << "|betas";
+  s << "|cubature," << o.elastic_samples_per_cell << ',' << o.fit_elastic_cubature;
+  if (o.inertia_samples_per_cell > 0) s << ",inertia," << o.inertia_samples_per_cell;  // keys of older files unchanged
+  s << "|betas";
   return s.str();
 }
 

@@ -163,6 +163,9 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   if (options.fit_elastic_cubature)
     a.elastic = basis::stiffness_fitted_cubature(a.tet, a.W, a.node_role, a.elastic, tet_moduli(a), &r.elastic_fit);
   const VecX rho = tet_densities(a);
+  if (options.inertia_samples_per_cell > 0)
+    a.inertia = basis::mass_fitted_cubature(a.tet, a.W, a.node_role, a.node_weights, rho,
+                                            options.inertia_samples_per_cell, &r.inertia_fit);
   r.elastic_errors = basis::cubature_errors(a.tet, a.elastic, rho);
   r.inertia_errors = basis::cubature_errors(a.tet, a.inertia, rho);
   r.cubature_s = t.seconds();
@@ -233,6 +236,11 @@ std::string PrecomputeReport::describe() const {
     o << "elastic cubature fitted to the basis stiffness: " << elastic_fit.samples << " of " << elastic_fit.candidates
       << " candidate tets kept, stiffness-tensor error " << pct(elastic_fit.stiffness_error_initial) << " % -> "
       << pct(elastic_fit.stiffness_error) << " % (" << elastic_fit.sweeps << " sweeps)\n";
+  if (inertia_fit.candidates > 0)
+    o << "inertia cubature fitted to the lumped mass matrix: " << inertia_fit.samples << " of "
+      << inertia_fit.candidates << " candidate nodes kept, " << inertia_fit.moments << " mass moments, error "
+      << pct(inertia_fit.moment_error_initial) << " % -> " << pct(inertia_fit.moment_error) << " %, mass "
+      << inertia_fit.mass << " kg (" << pct(inertia_fit.mass_error) << " % off, " << inertia_fit.sweeps << " sweeps)\n";
   return o.str();
 }
 

@@ -43,7 +43,10 @@ TetStiffness material_tet_stiffness(const Avatar& a) {
   };
 }
 
-MatX linearized_stiffness(const Avatar& a, const TetStiffness& tet_stiffness, bool mean_dilatation) {
+MatX linearized_stiffness(const Avatar& a, const TetStiffness& tet_stiffness, bool mean_dilatation,
+                          double per_tet_share) {
+  require(per_tet_share >= 0 && per_tet_share <= 1, "linearized_stiffness: per-tet volume share ", per_tet_share,
+          " is outside [0, 1]");
   const int n = a.num_reduced(), K = a.num_handles();
   MatX Kz = MatX::Zero(n, n);
   const VecX volume = fem::tet_volumes(a.tet);
@@ -84,7 +87,11 @@ MatX linearized_stiffness(const Avatar& a, const TetStiffness& tet_stiffness, bo
       add_sample_hessian(H, handle.data(), d.data(), m, 0, Kz, scratch);
       continue;
     }
-    add_sample_hessian(P * H * P, handle.data(), d.data(), m, 0, Kz, scratch);
+    // (1 − α) of the averaged form and α of the plain one: the deviatoric
+    // P H P is common; the cell terms below are linear in H, so they take (1 − α) H.
+    add_sample_hessian(per_tet_share * H + (1 - per_tet_share) * (P * H * P), handle.data(), d.data(), m, 0, Kz,
+                       scratch);
+    H *= 1 - per_tet_share;
     const Vec9 y = P * H * v;
     const Eigen::Map<const Mat3> Y(y.data());
     for (int e = 0; e < m; ++e) ac[size_t(c)].segment<3>(3 * handle[e]) += Y * d[e];  // Bᵀ y

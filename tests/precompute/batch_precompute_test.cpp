@@ -125,6 +125,9 @@ TEST(BatchKey, ChangesWithEveryInputThatChangesTheAvatar) {
   o.fit_elastic_cubature = false;
   differs(b, o, "cubature fit");
   o = base;
+  o.inertia_samples_per_cell = base.inertia_samples_per_cell == 5 ? 4 : 5;
+  differs(b, o, "inertia cubature");
+  o = base;
   o.bbw.drop_tolerance = 1e-5;
   differs(b, o, "bbw");
   o = base;

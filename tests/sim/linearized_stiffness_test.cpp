@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/linearized_stiffness.hpp"
 #include "synthetic_avatar.hpp"
@@ -114,11 +115,32 @@ TEST(LinearizedStiffness, MeanDilatationEqualsTheDenseBBarSum) {
     }
     expected += tet_volume(a, t) * B.transpose() * material_H(a, t) * B;
   }
-  const MatX K = linearized_stiffness(a, material_tet_stiffness(a), true);
+  const MatX K = linearized_stiffness(a, material_tet_stiffness(a), true, 0.0);
   EXPECT_LE((K - expected).norm(), 1e-10 * expected.norm());
   // And it differs from the plain assembly (the test would not see a no-op).
   const MatX K_plain = linearized_stiffness(a, material_tet_stiffness(a), false);
   EXPECT_GT((K - K_plain).norm(), 1e-3 * K_plain.norm());
+  // The partial average, written per tet from its definition: the averaged
+  // operator B̄ (∇ū) weighted 1 − α and the tet's own B weighted α.
+  for (double alpha : {0.2, 0.65}) {
+    MatX partial = MatX::Zero(n, n);
+    for (int t = 0; t < a.tet.num_elements(); ++t) {
+      const auto B = dense_B(a, t);
+      if (cell[t] < 0) {
+        partial += tet_volume(a, t) * B.transpose() * material_H(a, t) * B;
+        continue;
+      }
+      const Eigen::RowVectorXd tr = v.transpose() * B;
+      const MatX dev = B - v * tr / 3.0;
+      const MatX bar = dev + v * (g[size_t(cell[t])] / Vc[cell[t]]).transpose() / 3.0;
+      const Mat9 H = material_H(a, t);
+      partial += tet_volume(a, t) * ((1 - alpha) * bar.transpose() * H * bar + alpha * B.transpose() * H * B);
+    }
+    const MatX K_alpha = linearized_stiffness(a, material_tet_stiffness(a), true, alpha);
+    EXPECT_LE((K_alpha - partial).norm(), 1e-10 * partial.norm()) << "alpha " << alpha;
+    EXPECT_LE((K_alpha - ((1 - alpha) * K + alpha * K_plain)).norm(), 1e-10 * K_plain.norm()) << "alpha " << alpha;
+  }
+  EXPECT_THROW(linearized_stiffness(a, material_tet_stiffness(a), true, 1.5), Error);
 }
 
 TEST(LinearizedStiffness, HomogeneousStrainKeepsItsEnergy) {
@@ -139,7 +161,7 @@ TEST(LinearizedStiffness, HomogeneousStrainKeepsItsEnergy) {
   double expected = 0;
   for (int t = 0; t < a.tet.num_elements(); ++t) expected += 0.5 * tet_volume(a, t) * h.dot(material_H(a, t) * h);
   for (bool mean : {false, true}) {
-    const MatX K = linearized_stiffness(a, material_tet_stiffness(a), mean);
+    const MatX K = linearized_stiffness(a, material_tet_stiffness(a), mean, 0.0);
     EXPECT_NEAR(0.5 * z.dot(K * z), expected, 1e-9 * expected) << "mean_dilatation = " << mean;
   }
 }
@@ -151,7 +173,7 @@ TEST(LinearizedStiffness, IsotropicVolumeEnergyOnlyFallsWithTheMean) {
   o.rotated_frames = false;
   Avatar a = test::make_synthetic_avatar(o);
   for (RegionMaterial& m : a.materials) m.young_through = m.young_around = m.young_along;
-  const MatX K = linearized_stiffness(a, material_tet_stiffness(a), true);
+  const MatX K = linearized_stiffness(a, material_tet_stiffness(a), true, 0.0);
   const MatX K_plain = linearized_stiffness(a, material_tet_stiffness(a), false);
   std::mt19937 rng(7);
   std::normal_distribution<double> N(0, 0.01);

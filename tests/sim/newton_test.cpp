@@ -195,8 +195,11 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
     // Round-off level: the line search stops when E (~0.5 J, resolved to ~1e-16 J)
     // no longer decreases, at |g| ~ 1e-8 here; reassociating the Hessian's sums
     // (issue 13's exact speed-ups) moves the last iterate by round-off and |g|
-    // from just below to just above 1e-8, hence the margin.
-    EXPECT_LT(rep.grad_norm_after, 3e-8 * std::max(1.0, rep.grad_norm_before)) << rep.summary();
+    // from just below to just above 1e-8, hence the margin. Mean dilatation
+    // (the default since issue 13) couples each cell's tets in K, whose larger
+    // entries raise that floor to ~1e-7; not converging would leave |g| near
+    // its start (~0.8).
+    EXPECT_LT(rep.grad_norm_after, 3e-7 * std::max(1.0, rep.grad_norm_before)) << rep.summary();
     const StepReport rep1 = sim1.step(target);
     EXPECT_LT(rep1.energy_after, rep1.energy_before) << rep1.summary();  // one step decreases E
     EXPECT_EQ(rep1.iterations, 1);

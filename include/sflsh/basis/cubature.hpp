@@ -2,9 +2,12 @@
 // Data-oblivious cubature of the reduced model (Tapia et al. 2021; seed §4):
 // a scalar field interpolated by the basis, f ≈ Σ_k W_k f_k + w_bone f_bone,
 // is integrated exactly when each sample's weight is the integral of its
-// weight field, c_k = ∫ W_k dV. The same samples serve the elastic and the
+// weight field, c_k = ∫ W_k dV. The same samples can serve the elastic and the
 // inertial integrals (Avatar::elastic and Avatar::inertia may hold copies):
-// the method needs no training data for either.
+// the method needs no training data for either. Since issue 13 precompute
+// refits both, still without training data: elasticity to the basis'
+// stiffness (stiffness_fitted_cubature.hpp), inertia to the lumped mass
+// matrix (mass_fitted_cubature.hpp).
 #include <Eigen/Sparse>
 
 #include "sflsh/asset/avatar.hpp"

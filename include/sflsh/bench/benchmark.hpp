@@ -35,6 +35,9 @@ struct BenchOptions {
   double default_dt = 1.0 / 60.0;
   int converged_newton_iters = 20;        ///< the "Newton to convergence" variant
   PrecomputeOptions precompute;           ///< template/shape options (cache dir, ...)
+  /// Run only the variants whose label contains one of these strings (case
+  /// sensitive); the reference, the default and skinning always run. Empty: all.
+  std::vector<std::string> only;
 };
 
 /// rel_err of one body region (NaN when the region has no reference motion).

@@ -42,6 +42,7 @@
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/precompute/precompute.hpp"
+#include "sflsh/sim/soft_tissue_terms.hpp"
 
 namespace sflsh {
 
@@ -59,6 +60,9 @@ struct ContactBenchSettings {
   double probe_radius = 0.02;     ///< m
   double probe_depth = 0.015;     ///< m, deepest kinematic depth of the probe
   double probe_dt = 1.0 / 60.0;   ///< s
+  /// The reduced solver's SoftTissueOptions::mean_dilatation (false: every
+  /// tet's own volume change, as the full-FEM reference integrates it).
+  bool mean_dilatation = SoftTissueOptions().mean_dilatation;
   double probe_report_depth = 0.01;  ///< m: force_err is taken there
   std::vector<std::string> scenes;   ///< which scenes to run (empty: pressed, impact, probe)
 };
