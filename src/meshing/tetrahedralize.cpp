@@ -4,6 +4,7 @@
 #include <CGAL/Labeled_mesh_domain_3.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_error_code.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Random.h>
 #include <CGAL/exude_mesh_3.h>
@@ -129,6 +130,7 @@ TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, 
   require((box_max - box_min).minCoeff() > 0, "tetrahedralize_implicit: empty bounding box");
   require(o.facet_size > 0 && o.cell_size > 0 && o.facet_distance > 0,
           "tetrahedralize_implicit: facet_size, cell_size and facet_distance must be > 0");
+  require(o.max_vertices > 0, "tetrahedralize_implicit: max_vertices = ", o.max_vertices, ", expected > 0");
   TetrahedralizeReport local;
   TetrahedralizeReport& rep = report ? *report : local;
   rep = TetrahedralizeReport{};
@@ -138,7 +140,15 @@ TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, 
   CGAL::get_default_random() = CGAL::Random(o.seed);
   CGAL::Random domain_rng(o.seed);
 
-  LabelFunction label = [&inside](const K::Point_3& p) { return inside(Vec3(p.x(), p.y(), p.z())) ? 1 : 0; };
+  // Outside the box is outside the region, whatever `inside` says: Mesh_3
+  // bisects dual Voronoi segments that reach metres away, and a region that
+  // leaks out of the box (a wrong inside test far away) is an unbounded
+  // surface that refinement never finishes (scripts/results/cgal_hang.md).
+  LabelFunction label = [&inside, box_min, box_max](const K::Point_3& p) {
+    const Vec3 x(p.x(), p.y(), p.z());
+    if ((x.array() < box_min.array()).any() || (x.array() > box_max.array()).any()) return 0;
+    return inside(x) ? 1 : 0;
+  };
   const K::Iso_cuboid_3 box(box_min.x(), box_min.y(), box_min.z(), box_max.x(), box_max.y(), box_max.z());
   namespace p = CGAL::parameters;
   Domain domain(p::function = label, p::bounding_object = box,
@@ -184,8 +194,20 @@ TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, 
     }
   }
   Timer timer;
-  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
+  // A vertex budget turns runaway refinement (criteria the surface cannot
+  // meet, or a broken inside test) into one clear error instead of a hang.
+  CGAL::parameters::internal::Mesh_3_options budget;
+  CGAL::Mesh_error_code refine_code = CGAL::CGAL_MESH_3_NO_ERROR;
+  budget.maximal_number_of_vertices = std::size_t(o.max_vertices);
+  budget.pointer_to_error_code = &refine_code;
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_perturb(), p::no_exude(), p::no_reset_c3t3(), budget);
   rep.refine_s = timer.seconds();
+  require(refine_code == CGAL::CGAL_MESH_3_NO_ERROR, "tetrahedralize_implicit: Delaunay refinement stopped at ",
+          c3t3.triangulation().number_of_vertices(), " vertices after ", rep.refine_s,
+          " s, the limit TetrahedralizeOptions::max_vertices = ", o.max_vertices,
+          " (facet_distance ", o.facet_distance, " m, facet_size ", o.facet_size, " m, cell_size ", o.cell_size,
+          " m, facet_angle ", o.facet_angle_deg,
+          " deg); loosen facet_distance or the sizes, or check that the region is bounded by the box");
   timer.reset();
   if (o.odt_iterations > 0) {
     // ODT smoothing (bounded iteration count, no time limit: deterministic)

@@ -64,13 +64,17 @@ SurfaceQuery::SurfaceQuery(const Points& V, const Triangles& F) : impl_(std::mak
       const double angle = c > 0 ? std::acos(std::clamp(e1.dot(e2) / c, -1.0, 1.0)) : 0.0;
       impl_->vertex_n[F(f, i)] += angle * n;
       const int a = F(f, i), b = F(f, (i + 1) % 3);
-      edge_sum[{std::min(a, b), std::max(a, b)}] += n;
+      // Not edge_sum[key] += n: map::operator[] value-initializes a Vec3,
+      // and Eigen's default constructor leaves it uninitialized. Garbage from
+      // reused heap memory then flipped the sign of signed_distance() far
+      // outside the skin (scripts/results/cgal_hang.md).
+      edge_sum.try_emplace({std::min(a, b), std::max(a, b)}, Vec3::Zero()).first->second += n;
     }
   }
   for (int f = 0; f < nF; ++f)
     for (int i = 0; i < 3; ++i) {
       const int a = F(f, i), b = F(f, (i + 1) % 3);
-      impl_->edge_n[f][i] = edge_sum[{std::min(a, b), std::max(a, b)}];
+      impl_->edge_n[f][i] = edge_sum.at({std::min(a, b), std::max(a, b)});
     }
 }
 

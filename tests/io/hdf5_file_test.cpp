@@ -87,6 +87,18 @@ TEST(Hdf5File, TruncatedAndMissingFilesAreErrors) {
   EXPECT_THROW(Hdf5File(tmp.file("nope.h5"), Hdf5File::Mode::Read), Error);
 }
 
+TEST(Hdf5File, AFileOfAnotherTypeIsNamedAsNotHdf5) {
+  // A PNG signature and some bytes: refused up front, before libhdf5 tries to
+  // open it (mutation check M53, scripts/results/mutation.md).
+  test::TempDir tmp;
+  const std::string path = tmp.file("picture.h5");
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << "\x89PNG\r\n\x1a\n" << std::string(600, 'x');
+  }
+  test::expect_error([&] { Hdf5File f(path, Hdf5File::Mode::Read); }, {"picture.h5", "not an HDF5 file"});
+}
+
 TEST(Hdf5File, UncommittedWriteLeavesNoFile) {
   test::TempDir tmp;
   const std::string path = tmp.file("d.h5");

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <string>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/meshing/tetrahedralize.hpp"
 
 namespace sflsh {
@@ -91,6 +93,49 @@ TEST(Tetrahedralize, SizingFieldCoarsensWhereScaled) {
   // Uniform sizes: both halves alike, and the scaled mesh has fewer tets.
   const TetMesh u = shell_mesh(nullptr);
   EXPECT_LT(m.num_elements(), u.num_elements());
+}
+
+// A region that leaks out of the box (an inside test wrong far away, as the
+// template volume's was: scripts/results/cgal_hang.md) is cut at the box:
+// only the ball of radius 0.1 m is meshed, not the "inside" beyond |x| > 0.3 m.
+TEST(Tetrahedralize, RegionOutsideTheBoxIsIgnored) {
+  auto inside = [](const Vec3& x) { return x.norm() < 0.1 || x.norm() > 0.3; };
+  TetrahedralizeOptions o;
+  o.facet_size = 0.03;
+  o.facet_distance = 0.003;
+  o.cell_size = 0.04;
+  Points in(1, 3), out(1, 3);
+  in << 0, 0, 0;
+  out << 0.2, 0, 0;
+  TetrahedralizeReport rep;
+  const TetMesh m = tetrahedralize_implicit(inside, Vec3::Constant(-0.15), Vec3::Constant(0.15), in, out, o, &rep);
+  double rmax = 0;
+  for (int n = 0; n < m.num_nodes(); ++n) rmax = std::max(rmax, m.nodes.row(n).norm());
+  EXPECT_LT(rmax, 0.1 + 1e-5);
+  const double ball = 4.0 / 3.0 * M_PI * std::pow(0.1, 3);
+  EXPECT_NEAR(rep.quality.total_volume, ball, 0.06 * ball);
+}
+
+// Criteria the surface cannot meet within the vertex budget end in one error
+// naming the limit, not in hours of refinement.
+TEST(Tetrahedralize, VertexBudgetStopsRefinementWithAClearError) {
+  auto inside = [](const Vec3& x) { return x.norm() < 0.1; };
+  TetrahedralizeOptions o;
+  o.facet_distance = 1e-5;  // a 0.1 m sphere: ~10^5 surface vertices
+  o.max_vertices = 500;
+  Points in(1, 3), out(1, 3);
+  in << 0, 0, 0;
+  out << 0.2, 0, 0;
+  try {
+    tetrahedralize_implicit(inside, Vec3::Constant(-0.15), Vec3::Constant(0.15), in, out, o);
+    FAIL() << "expected sflsh::Error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("max_vertices = 500"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("facet_distance 1e-05"), std::string::npos) << msg;
+  }
+  o.max_vertices = 0;
+  EXPECT_THROW(tetrahedralize_implicit(inside, Vec3::Constant(-0.15), Vec3::Constant(0.15), in, out, o), Error);
 }
 
 }  // namespace

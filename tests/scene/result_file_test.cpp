@@ -61,6 +61,26 @@ TEST(ResultFile, RoundTripKeepsFramesAndDiagnostics) {
   EXPECT_EQ(f.shape("/frames/joints"), (std::vector<std::int64_t>{4, 24, 3}));
 }
 
+TEST(ResultFile, EveryFrameFieldComesBackFromItsOwnDataset) {
+  // small_result() gives each per-frame field its own value at frame f
+  // (positions 0.25 f, displacement 0.001 f, joints −0.5 f, reduced 0.01 f,
+  // step 1 + f ms): a reader taking one dataset for another shows here.
+  test::TempDir tmp;
+  write_simulation_result(small_result(), tmp.file("r.h5"));
+  const SimulationResult b = read_simulation_result(tmp.file("r.h5"));
+  ASSERT_EQ(b.num_frames, 4);
+  for (int f = 0; f < 4; ++f) {
+    EXPECT_DOUBLE_EQ(b.frame_time[f], f / 30.0);
+    // float32 storage: relative error <= 6e-8.
+    EXPECT_NEAR(b.frame_positions[f].maxCoeff(), 0.25 * f, 1e-7);
+    EXPECT_NEAR(b.frame_positions[f].minCoeff(), 0.25 * f, 1e-7);
+    EXPECT_NEAR(b.frame_displacement[f].maxCoeff(), 0.001 * f, 1e-9);
+    EXPECT_NEAR(b.frame_displacement[f].minCoeff(), 0.001 * f, 1e-9);
+    EXPECT_EQ(b.frame_joints[f], Points::Constant(24, 3, -0.5 * f));
+    EXPECT_EQ(b.frame_reduced[f], VecX::Constant(6, 0.01 * f));
+  }
+}
+
 TEST(ResultFile, UnfinishedStreamLeavesNoFile) {
   test::TempDir tmp;
   const SimulationResult r = small_result();

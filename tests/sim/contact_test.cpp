@@ -461,6 +461,29 @@ TEST(CapsuleContact, GradientHessianAndMomentumBetweenTwoBodies) {
   EXPECT_LT(torque.norm(), 1e-12 * d.grad.norm());
 }
 
+TEST(CapsuleContact, NoEnergyAtAGapAndHalfKDepthSquaredInOverlap) {
+  // Two rest-pose boxes side by side: parallel capsule axes (radius 3 cm,
+  // same y range), so by hand the signed distance is |shift| − 6 cm.
+  const Avatar a = box(), b = box();
+  const double k = 1.0e4;
+  const CapsuleContactTerm term(a, &b, {k, 2});
+  for (double shift : {0.061, 0.0601, 0.055}) {
+    Configuration qa, qb;
+    qa.bones.assign(24, Isometry::Identity());
+    qb.bones.assign(24, Isometry(Eigen::Translation3d(shift, 0, 0)));
+    qa.z = qb.z = VecX::Zero(0);
+    std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa}, {&b, body_layout(b, true), qb, qb, qb}};
+    for (Bound& bd : bodies) bd.layout.num_reduced = 0;
+    bodies[1].layout.base = bodies[0].layout.size();
+    StepContext ctx = bind_bodies(bodies, nullptr);
+    const auto cache = begin_term_step(term, ctx);
+    const Derivatives d = analytic(term, ctx, bodies);
+    const double depth = std::min(0.0, shift - 0.06);
+    EXPECT_NEAR(d.E, 0.5 * k * depth * depth, 1e-12) << "shift " << shift;
+    if (depth == 0.0) EXPECT_EQ(d.grad.norm(), 0.0) << "shift " << shift;
+  }
+}
+
 TEST(CapsuleContact, SelfContactSkipsAdjacentBonesAndPairsTouchingAtRest) {
   Avatar a = box();
   const Points J = a.joints_rest;

@@ -124,11 +124,16 @@ TEST(Elastic, InvertedElementGivesInfiniteEnergy) {
   EXPECT_LE(term.min_det(q.z), 0.0);
 }
 
-TEST(Damping, MatchesFiniteDifferencesAndVanishesAtRestVelocity) {
+/// The small slab (1 x 2 x 1 cells, 4 handles) of the damping tests.
+Avatar damping_slab() {
   test::SyntheticAvatarOptions o;
   o.nx = 1, o.ny = 2, o.nz = 1;
   o.handles = 4;
-  const Avatar a = test::make_synthetic_avatar(o);
+  return test::make_synthetic_avatar(o);
+}
+
+TEST(Damping, MatchesFiniteDifferencesAndVanishesAtRestVelocity) {
+  const Avatar a = damping_slab();
   const ElasticTerm elastic(a);
   const DampingTerm term(a, elastic, 0.01);
   StepContext ctx = z_only_context(a);
@@ -141,6 +146,41 @@ TEST(Damping, MatchesFiniteDifferencesAndVanishesAtRestVelocity) {
   EXPECT_GT(d.value, 0.0);
   EXPECT_LT((d.grad - test::fd_gradient(term, ctx, q, 1e-7)).norm(), 1e-6 * d.grad.norm());
   EXPECT_LT(test::hessian_fd_error(term, ctx, q, d.hess, 1e-5, 4, rng), 1e-6);
+}
+
+TEST(Damping, EnergyIsHalfBetaOverHTimesTheRestStiffness) {
+  // Rayleigh damping as an incremental potential: E = ½ (β/h) Δzᵀ K0 Δz with
+  // K0 the elastic Hessian at rest. K0 here by central differences of the
+  // elastic gradient (not the term's own matrix); halving h doubles E.
+  const Avatar a = damping_slab();
+  const ElasticTerm elastic(a);
+  const double beta = 0.02;
+  const DampingTerm term(a, elastic, beta);
+  StepContext ctx = z_only_context(a);
+  ctx.h = 0.01;
+  std::mt19937 rng(5);
+  ctx.q_prev = random_config(a, 0.003, rng);
+  const Configuration q = random_config(a, 0.003, rng);
+  const int n = a.num_reduced();
+  Configuration rest = q;
+  rest.z = VecX::Zero(n);
+  MatX K0(n, n);
+  const double eps = 1e-6;
+  for (int i = 0; i < n; ++i) {
+    Configuration p = rest, m = rest;
+    p.z[i] += eps, m.z[i] -= eps;
+    VecX gp = VecX::Zero(n), gm = VecX::Zero(n);
+    elastic.evaluate(ctx, p, &gp, nullptr);
+    elastic.evaluate(ctx, m, &gm, nullptr);
+    K0.col(i) = (gp - gm) / (2 * eps);
+  }
+  const VecX dz = q.z - ctx.q_prev.z;
+  const double expected = 0.5 * beta / ctx.h * dz.dot(K0 * dz);
+  ASSERT_GT(expected, 0.0);
+  // 1e-5: the difference quotient's own error (measured 2.2e-6).
+  EXPECT_NEAR(term.evaluate(ctx, q, nullptr, nullptr), expected, 1e-5 * expected);
+  ctx.h = 0.005;
+  EXPECT_NEAR(term.evaluate(ctx, q, nullptr, nullptr), 2 * expected, 2e-5 * expected);
 }
 
 }  // namespace

@@ -76,6 +76,22 @@ TEST(Tracking, ForceLimitedRootSpringIsHuber) {
   EXPECT_LT((g - test::fd_gradient(capped, ctx, q)).norm(), 1e-6 * g.norm());
 }
 
+TEST(Tracking, HuberSwitchesAtTheForceLimitRadius) {
+  // k = 1e4 N/m, F = 100 N: the spring turns into the constant force at
+  // d = F/k = 1 cm, by hand: E = ½ k r² for r <= d, F (r − d/2) beyond; at
+  // 1.5 cm that is 100 · (0.015 − 0.005) = 1.0 J (the plain spring: 1.125 J).
+  const Avatar a = test::make_tpose_skeleton();
+  Tracking capped(a, std::vector<double>(24, 0.0), 1e4, 100.0);
+  StepContext ctx = test::skeleton_context(a, test::bones_config(std::vector<Isometry>(24, Isometry::Identity())));
+  for (double off : {0.0099, 0.0101, 0.015, 0.019}) {
+    std::vector<Isometry> G(24, Isometry::Identity());
+    for (Isometry& g : G) g.translation() = Vec3(0.8, 0, -0.6) * off;  // horizontal
+    const Configuration q = test::bones_config(G);
+    const double expected = off <= 0.01 ? 0.5 * 1e4 * off * off : 100.0 * (off - 0.005);
+    EXPECT_NEAR(capped.evaluate(ctx, q, nullptr, nullptr), expected, 1e-12) << off;
+  }
+}
+
 TEST(Tracking, DerivativesMatchFiniteDifferences) {
   const Avatar a = test::make_tpose_skeleton();
   Tracking term(a, stiffness_ramp(), 1e4);

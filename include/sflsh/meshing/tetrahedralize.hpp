@@ -49,6 +49,11 @@ struct TetrahedralizeOptions {
   /// all nodes on it) whose smallest dihedral angle is below this are
   /// removed: they are flat caps that add nothing to the volume.
   double remove_boundary_slivers_below_deg = 8.0;
+  /// Vertex budget of Delaunay refinement: reaching it throws sflsh::Error
+  /// naming the criteria instead of refining on (a surface the criteria
+  /// cannot resolve would otherwise refine for hours). The procedural
+  /// body's default shell mesh has ~12k nodes.
+  long max_vertices = 1000000;
   unsigned seed = 1234;                ///< CGAL random seed (deterministic output)
 };
 
@@ -62,7 +67,8 @@ struct TetrahedralizeReport {
 };
 
 /// Tets of the region {x : inside(x)} inside the box [box_min, box_max]
-/// (which must contain the region with some margin). `inside` is queried at
+/// (which must contain the region with some margin; points outside the box
+/// count as outside whatever `inside` says). `inside` is queried at
 /// arbitrary points (millions of times) and must be deterministic.
 /// `seed_inside`/`seed_outside` (#S by 3 each) are pairs of points on either
 /// side of the boundary, at least one pair per connected boundary component
