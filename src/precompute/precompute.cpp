@@ -19,9 +19,17 @@
 
 namespace sflsh {
 
+// Revision of the meshing code whose output a cached template holds; bumped
+// when a fix changes the mesh for the same options, so that stale cache
+// entries (and batch outputs keyed on them) are rebuilt rather than reused.
+// 2: SurfaceQuery's edge pseudo-normals zero-initialized (2026-11-26; before,
+// heap garbage could flip the shell's inside test, scripts/results/cgal_hang.md).
+constexpr int kTemplateMesherRevision = 2;
+
 std::string template_cache_key(const BodyModel& model, const TemplateOptions& o) {
   std::ostringstream s;
-  s << std::setprecision(17) << body_model_hash(model) << '|' << kTemplateVolumeFormatVersion << '|' << o.inner_depth
+  s << std::setprecision(17) << body_model_hash(model) << '|' << kTemplateVolumeFormatVersion << '|'
+    << kTemplateMesherRevision << '|' << o.inner_depth
     << '|' << o.skinned_weight_threshold << '|' << o.correspondence.candidate_weight_fraction << '|'
     << o.correspondence.smoothing_iterations << '|' << o.correspondence.smoothing_lambda << '|'
     << o.mesh.facet_angle_deg << '|' << o.mesh.facet_size << '|' << o.mesh.facet_distance << '|'
