@@ -22,9 +22,11 @@ std::string StressReport::describe() const {
     << " rejected)\n"
     << "  finite state:            " << (finite ? "yes" : "NO") << "\n"
     << "  min det F over samples:  " << min_det << (no_inversion ? "" : "  (INVERTED)") << "\n"
+    << "  steps run / planned:     " << steps << " / " << planned_steps << (complete ? "" : "  (ENDED EARLY)") << "\n"
     << "  peak soft displacement:  first 10 % " << peak_soft_mm_early << " mm, last window " << peak_soft_mm_late
-    << " mm" << (stable ? "" : "  (GROWING)") << "\n"
-    << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm << " mm\n"
+    << " mm" << (stable ? "" : "  (GROWING)") << (windows.size() < 2 ? " (one window: no growth check)" : "") << "\n"
+    << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm
+    << " mm (every step)" << (tracking ? "" : "  (OVER THE TOLERANCE)") << "\n"
     << "  result: " << (passed() ? "PASSED" : "FAILED") << "\n";
   return o.str();
 }
@@ -44,8 +46,13 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
   ro.sim.h = o.dt;
   ro.sim.bones_dynamic = true;
   ro.seconds = std::min(double(o.steps) * o.dt, motion.duration());
-  ro.output_fps = 10;  // pelvis error sampled 10 times per second  // frames are not kept; the callback records everything
+  ro.output_fps = 10;  // frames are not kept and not used: the step callback records everything
   ro.keep_frames = false;
+  // The pelvis error is sampled after every step (the output frames' 10 fps
+  // missed the worst steps of a 2× clip: 28 mm read as lower).
+  const long planned = run_step_count(motion, ro);
+  const Vec3 pelvis_rest = avatar->joints_rest.row(0).transpose();
+  double pelvis_sum = 0;
 
   StressReport r;
   r.min_det = std::numeric_limits<double>::infinity();
@@ -72,6 +79,12 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     r.accepted += rep.accepted;
     r.damped += rep.damped;
     r.rejected += rep.rejected;
+    // Simulated pelvis (joint 0) vs the motion's root at this step's time, as run_simulation's frames measure it.
+    const Vec3 target = target_bones(*avatar, motion.sample(double(step) * o.dt))[0] * pelvis_rest;
+    const double pelvis_mm = 1e3 * (sim.state().bones[0] * pelvis_rest - target).norm();
+    r.pelvis_error_max_mm = std::max(r.pelvis_error_max_mm, pelvis_mm);
+    pelvis_sum += pelvis_mm;
+    r.pelvis_error_mean_mm = pelvis_sum / double(step);
     if (step % o.window == 0) {
       w.t_end = double(step) * o.dt;
       w.ms_median = percentile(ms, 0.5);
@@ -82,9 +95,7 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     }
   };
   try {
-    const SimulationResult res = run_simulation(avatar, motion, ro);
-    r.pelvis_error_max_mm = 1e3 * res.pelvis_error_max;
-    r.pelvis_error_mean_mm = 1e3 * res.pelvis_error_mean;
+    run_simulation(avatar, motion, ro);
   } catch (const Error& e) {
     r.finite = false;
     std::fprintf(stderr, "stress: %s\n", e.what());
@@ -105,8 +116,10 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
   if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;
   r.no_inversion = r.min_det > 0;
-  const long expected = std::min(o.steps, long(std::floor(motion.duration() / o.dt + 1e-9)));
-  r.stable = r.finite && r.steps == expected && r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
+  r.planned_steps = planned;
+  r.complete = r.steps == planned;
+  r.stable = r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
+  r.tracking = o.pelvis_tolerance_mm <= 0 || r.pelvis_error_max_mm <= o.pelvis_tolerance_mm;
   return r;
 }
 

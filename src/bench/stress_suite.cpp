@@ -50,7 +50,14 @@ StressCaseResult from_report(const std::string& name, const std::string& setup, 
   }
   if (!r.passed()) {
     c.status = "FAILED";
-    c.message = !r.finite ? "non-finite state" : !r.no_inversion ? "inverted cubature sample" : "soft displacement grew";
+    c.message = !r.finite         ? "non-finite state"
+                : !r.no_inversion ? "inverted cubature sample"
+                : !r.complete     ? "ended after " + std::to_string(r.steps) + " of " +
+                                    std::to_string(r.planned_steps) + " steps"
+                : !r.tracking     ? "pelvis " + fmt(r.pelvis_error_max_mm, 1) + " mm from the motion's root (> " +
+                                    fmt(StressOptions().pelvis_tolerance_mm, 0) + " mm)"
+                                  : "soft displacement grew (last window " + fmt(r.peak_soft_mm_late, 1) +
+                                        " mm, first 10 % " + fmt(r.peak_soft_mm_early, 1) + " mm)";
   }
   return c;
 }

@@ -90,15 +90,19 @@ std::vector<Isometry> target_bones(const Avatar& avatar, const BodyPose& pose) {
   return bone_transforms_from_pose(avatar.joints_rest, avatar.parents, pose);
 }
 
+long run_step_count(const MotionClip& motion, const RunOptions& options) {
+  const double seconds = options.seconds > 0 ? options.seconds : motion.duration();
+  return std::max(1L, long(std::llround(seconds / options.sim.h)));
+}
+
 SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
                                 const std::function<void(const FrameData&)>& on_frame) {
   require(motion.num_frames() > 0, motion.name, ": motion has no frames");
   const double h = options.sim.h;
   require(h > 0 && std::isfinite(h), "time step must be positive, got ", h);
   require(options.output_fps > 0, "--output-fps must be positive, got ", options.output_fps);
-  const double seconds = options.seconds > 0 ? options.seconds : motion.duration();
-  require(seconds > 0, motion.name, ": motion lasts 0 s; give a duration");
-  const long steps = std::max(1L, long(std::llround(seconds / h)));
+  require(options.seconds > 0 || motion.duration() > 0, motion.name, ": motion lasts 0 s; give a duration");
+  const long steps = run_step_count(motion, options);
 
   Simulator sim(avatar_model(avatar, options.sim, options.sim.bones_dynamic ? &options.skeleton : nullptr));
   std::vector<Isometry> targets = target_bones(*avatar, motion.sample(0.0));

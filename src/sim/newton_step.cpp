@@ -9,6 +9,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/sim/step_cap.hpp"
 
 namespace sflsh {
 namespace {
@@ -16,24 +17,14 @@ namespace {
 constexpr int kMaxHalvings = 20;
 constexpr double kArmijo = 1e-4;
 
-/// Largest scale ≤ 1 keeping every handle step and bone rotation step within the caps.
-double step_cap(const VecX& delta, const std::vector<DofLayout>& bodies, const NewtonOptions& o) {
-  double scale = 1.0;
-  if (o.max_z_step > 0) {
-    double m = 0;
-    for (const DofLayout& layout : bodies)
-      for (int k = 0; k < layout.num_reduced / 3; ++k)
-        m = std::max(m, delta.segment<3>(layout.z_offset() + 3 * k).norm());
-    if (m > o.max_z_step) scale = std::min(scale, o.max_z_step / m);
-  }
-  if (o.max_rotation_step > 0) {
-    double m = 0;
-    for (const DofLayout& layout : bodies)
-      if (layout.bones_dynamic)
-        for (int i = 0; i < layout.num_bones; ++i) m = std::max(m, delta.segment<3>(layout.bone_offset(i)).norm());
-    if (m > o.max_rotation_step) scale = std::min(scale, o.max_rotation_step / m);
-  }
-  return scale;
+/// Each body's skeleton parent table, from the avatar of a term bound to it (null if none is).
+std::vector<const std::vector<int>*> body_parents(const StepSystem& sys) {
+  std::vector<const std::vector<int>*> parents(sys.bodies.size(), nullptr);
+  for (const SystemTerm& t : sys.terms)
+    for (const BoundBody& b : t.ctx->bound)
+      if (b.avatar && b.slot >= 0 && b.slot < int(parents.size()) && !b.avatar->parents.empty())
+        parents[b.slot] = &b.avatar->parents;
+  return parents;
 }
 
 std::vector<Configuration> retract_all(const std::vector<Configuration>& q, const VecX& delta,
@@ -180,10 +171,30 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
 
-    double alpha = step_cap(delta, sys.bodies, o);
+    // Caps (sim/step_cap.hpp); either counts the step as damped. Leaf bones
+    // over the rotation cap are capped alone (the handle cap still scales the
+    // whole step). If an inner bone is over it, or the per-bone step is not
+    // admissible (an inverted element), the whole step is scaled to the caps.
+    Timer tl;
+    double alpha = 1.0, capped_slope = slope, a_whole = 1.0;
+    bool bones_capped = false;  // the per-bone capped step is being tried
+    VecX whole;
+    if (o.max_rotation_step > 0 && rotation_step_scale(delta, sys.bodies, o.max_rotation_step) < 1.0 &&
+        rotation_cap_per_bone_applies(delta, sys.bodies, body_parents(sys), o.max_rotation_step)) {
+      whole = delta;
+      a_whole = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
+                         rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
+      cap_bone_rotations(delta, q, sys.bodies, o.max_rotation_step);
+      alpha = handle_step_scale(delta, sys.bodies, o.max_z_step);
+      // Armijo's slope along the capped direction; one that does not descend may not raise E.
+      capped_slope = std::min(0.0, g.dot(delta));
+      bones_capped = true;
+    } else {
+      alpha = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
+                       rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
+    }
     std::vector<Configuration> trial;
     bool ok = false;
-    Timer tl;
     // On the last iteration the trial evaluation doubles as the final report's.
     const bool last = it + 1 == o.iterations && o.report_final;
     for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
@@ -192,9 +203,17 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
           total_energy(sys, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr, &term_ms);
       final_valid = last;
       const bool admissible = std::isfinite(E1);
-      if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * slope) : admissible) {
+      if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * capped_slope) : admissible) {
         ok = true;
         break;
+      }
+      if (bones_capped && whole.size() > 0) {  // fall back to the whole step scaled to the caps
+        delta = std::move(whole);
+        whole.resize(0);
+        alpha = 2.0 * a_whole;  // halved by the loop's increment
+        capped_slope = slope;
+        bones_capped = false;
+        --halving;
       }
     }
     rep.ms_assemble += tl.ms();
@@ -214,8 +233,9 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     } else {
       q = std::move(trial);
       rep.step_scale = alpha;
-      outcome = alpha == 1.0 ? StepOutcome::Accepted : StepOutcome::Damped;
-      (alpha == 1.0 ? rep.accepted : rep.damped)++;
+      const bool full = alpha == 1.0 && !bones_capped;  // a_whole < 1 when the fallback ran
+      outcome = full ? StepOutcome::Accepted : StepOutcome::Damped;
+      (full ? rep.accepted : rep.damped)++;
     }
     if (int(outcome) > int(rep.outcome)) rep.outcome = outcome;
     if (!ok) break;

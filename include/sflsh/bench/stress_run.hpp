@@ -24,6 +24,9 @@ struct StressOptions {
   /// Peak soft displacement over the last window may be at most this times
   /// the largest over the first 10 % of the run (no energy growth).
   double growth_limit = 1.5;
+  /// The simulated pelvis may be at most this far from the motion's root
+  /// after any step (mm; scripts/mocap_check.sh's 20 mm). ≤ 0: not checked.
+  double pelvis_tolerance_mm = 20;
 };
 
 struct StressWindow {
@@ -41,12 +44,17 @@ struct StressReport {
   int accepted = 0, damped = 0, rejected = 0;
   double min_det = 0;            ///< over the whole run
   double peak_soft_mm = 0;       ///< over the whole run
-  /// Simulated pelvis vs the motion's root over the output frames (mm).
+  /// Simulated pelvis (joint 0) vs the motion's root after every step (mm): max, mean over the steps.
   double pelvis_error_max_mm = 0, pelvis_error_mean_mm = 0;
+  long planned_steps = 0;        ///< steps the run should take (run_step_count)
   double ms_median = 0;          ///< step wall time (ms)
   double peak_soft_mm_early = 0, peak_soft_mm_late = 0;  ///< first 10 % of windows, last window
-  bool finite = true, stable = true, no_inversion = true;
-  bool passed() const { return finite && stable && no_inversion; }
+  /// finite: no non-finite state; complete: steps == planned_steps; stable:
+  /// the last window's peak soft displacement ≤ growth_limit × the first 10 %
+  /// of windows' (trivially true with one window, e.g. a 2× CMU clip);
+  /// no_inversion: min det F > 0; tracking: pelvis_error_max_mm ≤ the tolerance.
+  bool finite = true, complete = true, stable = true, no_inversion = true, tracking = true;
+  bool passed() const { return finite && complete && stable && no_inversion && tracking; }
   std::string describe() const;
 };
 

@@ -126,6 +126,12 @@ class SimulationStopped : public Error {
 SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
                                 const std::function<void(const FrameData&)>& on_frame = {});
 
+/// Steps run_simulation takes (without a resume): max(1, round(seconds / h)),
+/// seconds = options.seconds if > 0, else the motion's duration (s). A clip
+/// whose duration is not a whole number of steps gets its last step past its
+/// end when the remainder is ≥ h/2 (the motion holds its last frame there).
+long run_step_count(const MotionClip& motion, const RunOptions& options);
+
 /// Bone transforms (24 world) of a motion pose on the avatar's skeleton.
 std::vector<Isometry> target_bones(const Avatar& avatar, const BodyPose& pose);
 

@@ -23,12 +23,17 @@ struct NewtonOptions {
   /// (the iterate is kept) instead of counting as rejected.
   bool line_search = false;
   /// Largest change of any handle displacement z_k per iteration (m); longer
-  /// steps are scaled down as a whole (counted as damped). ≤ 0 disables.
+  /// steps are scaled down as a whole, bones included (counted as damped).
+  /// ≤ 0 disables.
   double max_z_step = 0.05;
-  /// Largest bone rotation change per iteration (rad); ≤ 0 disables. Fast
-  /// mocap (a jog's feet turn 0.66 rad per 1/60 s step) needs more than 0.5:
-  /// a cap scales the whole step, pelvis included (CMU 16_46: pelvis error
-  /// 25.5 mm at 0.5 rad, 1.6 mm at 1 rad; same figures with no cap).
+  /// Largest bone rotation change per iteration (rad); ≤ 0 disables. When a
+  /// bone is over it, two steps are tried (sim/step_cap.hpp) and the one of
+  /// lower energy is taken (counted as damped): the per-bone cap (that bone
+  /// turns by the cap about the same axis, its joint moving as in the full
+  /// step; the other bones and z take their full step) and the whole step
+  /// scaled to the cap. The whole step alone held the pelvis back when a toe
+  /// was over the cap (CMU at 2×, dt = 1/30: up to 67 mm); the per-bone cap
+  /// alone shears the flesh on targets jumping ~3 rad (builtin:torture).
   double max_rotation_step = 1.0;
   /// Diagonal regularization, used only when the Cholesky factorization of H
   /// itself fails (H is PSD by construction and PD when every DoF has mass):
