@@ -444,7 +444,11 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     if (wanted(what) || (before && wanted(both))) {
       log_info("bench: shape stage for " + what);
       const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
-      if (wanted(what)) reduced(a, K, h, 1, what + " (" + std::to_string(a->inertia.size()) + " samples)", false);
+      const std::string label = what + " (" + std::to_string(a->inertia.size()) + " samples)";
+      if (wanted(what)) reduced(a, K, h, 1, label, false);
+      // The combination issue 13 measured: mean dilatation with the fitted inertia.
+      if (po.inertia_samples_per_cell > 0 && !SimulatorOptions().mean_dilatation && wanted(what))
+        reduced(a, K, h, 1, label + " + mean dilatation", false, true);
       // Both of issue 13's changes undone: the defaults before them.
       if (before && wanted(both)) reduced(a, K, h, 1, both, false, false);
     }

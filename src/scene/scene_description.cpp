@@ -144,8 +144,13 @@ class SceneParser {
     const std::string given = text(n, key);
     if (given.empty()) error(n, key, "expected a file name");
     const fs::path p = fs::path(given).is_absolute() ? fs::path(given) : folder_ / given;
-    if (!fs::is_regular_file(p)) error(n, key, what, " not found: ", p.string(), hint);
-    return fs::absolute(p).lexically_normal().string();
+    // The error_code overloads: a name the OS refuses (too long, ...) is "not
+    // found" with the scene's position, not a filesystem_error (fuzz finding).
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) error(n, key, what, " not found: ", p.string(), hint);
+    const fs::path full = fs::absolute(p, ec);
+    if (ec) error(n, key, what, " has a path the system refuses: ", p.string(), " (", ec.message(), ")");
+    return full.lexically_normal().string();
   }
 
  private:
