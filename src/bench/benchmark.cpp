@@ -439,18 +439,14 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     po.inertia_samples_per_cell = o.precompute.inertia_samples_per_cell > 0 ? 0 : 2;
     const std::string what = po.inertia_samples_per_cell > 0 ? "inertia mass-fitted"
                                                              : "inertia at the handles (data-oblivious, before)";
-    const bool before = po.inertia_samples_per_cell == 0 && SimulatorOptions().mean_dilatation;
-    const std::string both = "before issue 13's accuracy fixes (volume per tet, inertia at the handles)";
-    if (wanted(what) || (before && wanted(both))) {
+    if (wanted(what)) {
       log_info("bench: shape stage for " + what);
       const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
       const std::string label = what + " (" + std::to_string(a->inertia.size()) + " samples)";
-      if (wanted(what)) reduced(a, K, h, 1, label, false);
+      reduced(a, K, h, 1, label, false);
       // The combination issue 13 measured: mean dilatation with the fitted inertia.
-      if (po.inertia_samples_per_cell > 0 && !SimulatorOptions().mean_dilatation && wanted(what))
+      if (po.inertia_samples_per_cell > 0 && !SimulatorOptions().mean_dilatation)
         reduced(a, K, h, 1, label + " + mean dilatation", false, true);
-      // Both of issue 13's changes undone: the defaults before them.
-      if (before && wanted(both)) reduced(a, K, h, 1, both, false, false);
     }
   }
   for (bool reskin : o.peer && wanted("Bullet") ? std::vector<bool>{false, true} : std::vector<bool>{}) {
