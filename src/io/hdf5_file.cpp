@@ -435,4 +435,11 @@ double Hdf5File::read_scalar(const std::string& name) const {
   return v[0];
 }
 
+int Hdf5File::read_int_scalar(const std::string& name, int lo, int hi) const {
+  const double v = read_scalar(name);
+  if (!(v >= lo && v <= hi) || v != std::floor(v))
+    fail(path_, ": dataset ", name, " is ", v, ", expected a whole number in [", lo, ", ", hi, "]");
+  return int(v);
+}
+
 }  // namespace sflsh::io

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <string_view>
@@ -19,6 +20,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/ply_structure.hpp"
 #include "sflsh/io/surface_normals.hpp"
 
 namespace sflsh::io {
@@ -292,26 +294,19 @@ ImportedMesh imported_triangles(const aiScene* scene, const std::string& path) {
   return out;
 }
 
-// assimp 5.2 loops forever on a PLY file whose header has no end_header line
-// (e.g. a truncated file; found by scripts/fuzz.sh): check that first. `head`
-// is the start of the file (its first kPlyHeaderLimit bytes or all of it).
-constexpr std::size_t kPlyHeaderLimit = 1 << 20;
-void check_ply_header(std::string_view head, const std::string& path) {
-  if (head.substr(0, 3) != "ply") return;
-  require(head.find("end_header") != std::string_view::npos, path, ": PLY header without an end_header line in its first ",
-          std::min(head.size(), kPlyHeaderLimit), " bytes (truncated file?)");
-}
-
 }  // namespace
 
 ImportedMesh read_mesh(const std::string& path) {
   require(fs::exists(path), path, ": no such file");
   {
     std::ifstream in(path, std::ios::binary);
-    std::string head(kPlyHeaderLimit, '\0');
-    in.read(head.data(), std::streamsize(head.size()));
-    head.resize(std::size_t(in.gcount()));
-    check_ply_header(head, path);
+    char magic[3] = {};
+    in.read(magic, 3);
+    if (in.gcount() == 3 && std::string_view(magic, 3) == "ply") {  // assimp trusts PLY headers: check first
+      in.seekg(0);
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      check_ply_structure(bytes, path);
+    }
   }
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, kImportSteps);
@@ -322,7 +317,7 @@ ImportedMesh read_mesh(const std::string& path) {
 ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std::string& format,
                                    const std::string& name) {
   require(size > 0, name, ": empty mesh file");
-  check_ply_header(std::string_view(static_cast<const char*>(data), std::min(size, kPlyHeaderLimit)), name);
+  check_ply_structure(std::string_view(static_cast<const char*>(data), size), name);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
   if (!scene) fail(name, ": cannot read mesh: ", importer.GetErrorString());

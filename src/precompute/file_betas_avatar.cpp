@@ -71,7 +71,7 @@ std::string matching_template(const std::string& cache_dir, const std::string& m
       const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
       if (!f.has("/template/format_version") || !f.has("/template/model_hash") || !f.has("/template/tet/elements"))
         continue;
-      if (int(f.read_scalar("/template/format_version")) != kTemplateVolumeFormatVersion) continue;
+      if (f.read_scalar("/template/format_version") != kTemplateVolumeFormatVersion) continue;
       if (f.read_string("/template/model_hash") != model_hash) continue;
       const auto shape = f.shape("/template/tet/elements");
       if (shape.size() != 2 || shape[0] != elements.rows() || shape[1] != 4) continue;

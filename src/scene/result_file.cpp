@@ -246,7 +246,7 @@ SimulationResult read_simulation_result(const std::string& path) {
   r.motion = f.read_string("/meta/motion");
   r.dt = f.read_scalar("/meta/dt");
   r.bones_dynamic = f.read_string("/meta/bones") == "dynamic";
-  r.newton_iters = int(f.read_scalar("/meta/newton_iters"));
+  r.newton_iters = f.read_int_scalar("/meta/newton_iters", 0, 1000000);
   if (f.has("/meta/incomplete")) {  // absent in files written before it existed: complete
     const double inc = f.read_scalar("/meta/incomplete");
     require(inc == 0 || inc == 1, path, ": dataset /meta/incomplete is ", inc, ", expected 0 or 1");

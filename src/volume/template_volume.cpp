@@ -406,7 +406,11 @@ void save_template_volume(const TemplateVolume& tv, const std::string& path) {
   const int nS = int(tv.segments.size());
   Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor> seg(nS, 2);
   VecX ext(nS);
-  for (int s = 0; s < nS; ++s) seg.row(s) << tv.segments[s].joint, tv.segments[s].child, ext[s] = tv.segments[s].extension;
+  for (int s = 0; s < nS; ++s) {
+    seg(s, 0) = tv.segments[s].joint;
+    seg(s, 1) = tv.segments[s].child;
+    ext[s] = tv.segments[s].extension;
+  }
   h5.write_matrix(g + "segments/joints", seg);
   h5.write_matrix(g + "segments/extension", ext);
   h5.write_matrix(g + "surface/coefficients", tv.surface.coefficients);
@@ -438,7 +442,7 @@ TemplateVolume load_template_volume(const std::string& path) {
   io::Hdf5File h5(path, io::Hdf5File::Mode::Read);
   const std::string g = "/template/";
   TemplateVolume tv;
-  const int version = int(h5.read_scalar(g + "format_version"));
+  const int version = h5.read_int_scalar(g + "format_version", 0, 1 << 20);
   require(version == kTemplateVolumeFormatVersion, path, ": dataset ", g, "format_version is ", version,
           ", expected ", kTemplateVolumeFormatVersion);
   tv.model_hash = h5.read_string(g + "model_hash");

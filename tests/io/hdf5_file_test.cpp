@@ -213,3 +213,35 @@ TEST(Hdf5File, UnusualNumberTypesAreRefused) {
   write_raw_dataset(tmp.file("u.h5"), "/u", H5T_STD_U8LE, H5T_NATIVE_UCHAR, u, 2);
   EXPECT_EQ(Hdf5File(tmp.file("u.h5"), Hdf5File::Mode::Read).read_matrix("/u", 2, 1)(0, 0), 200.0);
 }
+
+// A count stored as a double (result files' /meta/newton_iters) is read as an int only when it is
+// a whole number in range: a fuzzed 4.2e9 used to be converted to int (undefined behaviour).
+TEST(Hdf5File, IntScalarIsAWholeNumberInRange) {
+  test::TempDir tmp;
+  const std::string path = tmp.file("c.h5");
+  {
+    Hdf5File f(path, Hdf5File::Mode::Write);
+    f.write_scalar("/ok", 7.0);
+    f.write_scalar("/big", 4.2e9);
+    f.write_scalar("/half", 2.5);
+    f.write_scalar("/nan", std::numeric_limits<double>::quiet_NaN());
+    f.write_scalar("/negative", -1.0);
+    f.commit();
+  }
+  Hdf5File f(path, Hdf5File::Mode::Read);
+  EXPECT_EQ(f.read_int_scalar("/ok", 0, 100), 7);
+  EXPECT_EQ(f.read_int_scalar("/ok", 7, 7), 7);
+  for (const char* name : {"/big", "/half", "/nan", "/negative"}) {
+    try {
+      f.read_int_scalar(name, 0, 1000000);
+      ADD_FAILURE() << name << " accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("c.h5: dataset " + std::string(name)), std::string::npos) << what;
+      // NaN is refused by every reader already (read_nd), the others by the range check.
+      EXPECT_NE(what.find(std::string(name) == "/nan" ? "non-finite" : "whole number in [0, 1000000]"),
+                std::string::npos)
+          << what;
+    }
+  }
+}

@@ -114,6 +114,9 @@ class Hdf5File {
   std::vector<std::string> read_strings(const std::string& name) const;
   std::string read_string(const std::string& name) const;
   double read_scalar(const std::string& name) const;
+  /// A scalar that must be a whole number in [lo, hi]; anything else (NaN, 4e9, 2.5) is an
+  /// error naming the file and the dataset.
+  int read_int_scalar(const std::string& name, int lo, int hi) const;
 
   template <class M>
   M read_as(const std::string& name, std::int64_t rows = -1, std::int64_t cols = -1) const {
