@@ -3,6 +3,7 @@
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     (default: 60 s each, every target)
 #   FUZZ_RUNS=1000000 scripts/fuzz.sh 1800 ... stops a target at 10^6 executions or 30 min,
 #   whichever comes first (the reliability issue's budget per target).
+#   FUZZ_JOBS=N fuzzes N targets at a time (one core each).
 #   FUZZ_TIMEOUT=S sets the per-input time limit (default 10 s); on a machine whose other jobs
 #   starve the fuzzer, a 10 s wall-clock limit reports false timeouts (replay them to check).
 # Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5 material
@@ -117,9 +118,18 @@ run_target() {
 
 echo "fuzzing ${TARGETS[*]} for $SECONDS_TO_RUN s each ..."
 failed=0
+# FUZZ_JOBS=N runs N targets at a time (one core each; default 1).
+JOBS="${FUZZ_JOBS:-1}"
+running=()
 for t in "${TARGETS[@]}"; do
-  run_target "$t" || failed=1
+  run_target "$t" &
+  running+=($!)
+  if [ ${#running[@]} -ge "$JOBS" ]; then
+    wait "${running[0]}" || failed=1
+    running=("${running[@]:1}")
+  fi
 done
+for pid in "${running[@]}"; do wait "$pid" || failed=1; done
 if [ "$failed" -ne 0 ]; then
   echo "findings are in $OUT/crashes/<target>/: replay with SFLSH_FUZZ_REPLAY_DIR=$OUT/crashes build/test_fuzz"
   exit 1

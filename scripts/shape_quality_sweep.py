@@ -103,6 +103,10 @@ def write(path, sections):
                 "|---|---|---|---|---|---|---|"]
         out += ["| %s | %s | %s | %s | %s | %s | %s |" % (r[0], r[1], r[2], r[3], r[4], r[5], "yes" if ok(r) else "**no**")
                 for r in rows]
+        failures = [r for r in rows if r[1] == "failed" and len(r) > 6]
+        if failures:
+            out += ["", "Why the failed shapes stopped (the shape stage's error):", ""]
+            out += ["- %s: %s" % (r[0], r[6]) for r in failures]
         out.append("")
         all_ok = all_ok and good == len(rows)
     os.makedirs(os.path.dirname(path), exist_ok=True)

@@ -10,6 +10,7 @@
 # OUT/{e2e.json,run.txt,live.png,load.txt}.
 #   [GL=swiftshader|angle-swiftshader|in-process|egl] [QUERY='?aa=0'] \
 #   scripts/viewer_figures.sh AVATAR.h5 [OUT=out/viewer] [HOLD=10]
+# DT is the physics time step (default 1/500 s).
 # GL picks chromium's GPU-less WebGL back end (apps/viewer/test/e2e.mjs);
 # QUERY the page's options (?aa=0: no antialiasing; &mat=standard: PBR skin).
 # Needs a built sflsh, chromium and apps/viewer/node_modules (scripts/setup.sh).
@@ -20,10 +21,11 @@ OUT="${2:-out/viewer}"
 HOLD="${3:-10}"
 PORT="${PORT:-8093}"
 GL="${GL:-swiftshader}"
+DT="${DT:-1/500}"
 QUERY="${QUERY:-?aa=0}"
 mkdir -p "$OUT"
 cat > "$OUT/probe_belly.yaml" <<YAML
-solver: {dt: 1/500, seconds: 600}
+solver: {dt: ${DT:-1/500}, seconds: 600}
 output: {fps: 30}
 bodies:
   - {name: alice, avatar: $AVATAR, motion: none, bones: kinematic}

@@ -19,6 +19,7 @@ struct StressArgs {
   std::string avatar, motion = "builtin:shake", dt = "1/30", out = "stress";
   long steps = 10000;
   double speed = 1;
+  bool mean_dilatation = false;
 };
 
 struct SuiteArgs {
@@ -81,6 +82,7 @@ void run_stress_command(const StressArgs& a) {
   o.dt = parse_time_step(a.dt);
   o.steps = a.steps;
   o.speed = a.speed;
+  o.mean_dilatation = a.mean_dilatation;
   require(std::isfinite(a.speed) && a.speed > 0, "--speed must be positive, got ", a.speed);
   require(a.steps >= 1, "--steps must be >= 1, got ", a.steps);
   io::check_output_folder(a.out, "--out");
@@ -107,6 +109,8 @@ const CommandRegistrar reg(55, [](CLI::App& app) {
   cmd->add_option("--dt", a->dt, "Time step in seconds (e.g. 1/30)")->capture_default_str();
   cmd->add_option("--steps", a->steps, "Number of time steps")->capture_default_str();
   cmd->add_option("--out", a->out, "Output folder (stress.csv, stress.svg)")->capture_default_str();
+  cmd->add_flag("--mean-dilatation,!--volume-per-tet", a->mean_dilatation,
+                "Average the elastic volume change per cell (opt-in, as `simulate --mean-dilatation`)");
   cmd->callback([a] { run_stress_command(*a); });
 });
 

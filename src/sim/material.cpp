@@ -109,6 +109,25 @@ MaterialPoint::MaterialPoint(const RegionMaterial& m, const Mat3& frame) {
   kappa = Ebar / (3.0 * (1.0 - 2.0 * m.poisson));
 }
 
+Mat3 determinant_gradient(const Mat3& F) {
+  Mat3 cof;
+  cof.col(0) = F.col(1).cross(F.col(2));
+  cof.col(1) = F.col(2).cross(F.col(0));
+  cof.col(2) = F.col(0).cross(F.col(1));
+  return cof;
+}
+
+Mat9 determinant_hessian(const Mat3& F) {
+  Mat9 HJ = Mat9::Zero();
+  HJ.block<3, 3>(0, 3) = -hat(F.col(2));
+  HJ.block<3, 3>(0, 6) = hat(F.col(1));
+  HJ.block<3, 3>(3, 0) = hat(F.col(2));
+  HJ.block<3, 3>(3, 6) = -hat(F.col(0));
+  HJ.block<3, 3>(6, 0) = -hat(F.col(1));
+  HJ.block<3, 3>(6, 3) = hat(F.col(0));
+  return HJ;
+}
+
 Mat9 linearized_hessian(const MaterialPoint& material) {
   Mat9 H;
   strain_energy_density(Mat3::Identity(), material, nullptr, &H, false);
@@ -167,10 +186,7 @@ double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3*
     }
     const Mat3 P_stvk = F * S;  // first Piola–Kirchhoff stress of StVK
     // ∂J/∂F = cofactor(F) = J F^{-T}, columns f1 × f2, f2 × f0, f0 × f1.
-    Mat3 cof;
-    cof.col(0) = F.col(1).cross(F.col(2));
-    cof.col(1) = F.col(2).cross(F.col(0));
-    cof.col(2) = F.col(0).cross(F.col(1));
+    const Mat3 cof = determinant_gradient(F);
     if (dPsi_dF) *dPsi_dF = dphi * P_stvk + dvol * cof;
     if (d2Psi_dF2) {
       // B = ∂e/∂vec(F) (6x9): ∂E_ab/∂f_a = ½ f_b, ∂E_ab/∂f_b = ½ f_a (f_a = column a of F).
@@ -185,14 +201,7 @@ double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3*
       const Mat3 S_geometric = project_psd ? positive_part(S) : S;
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) H_stvk.block<3, 3>(3 * a, 3 * b).diagonal().array() += S_geometric(a, b);
-      // ∂²J/∂F² (blocks over the columns f0, f1, f2 of F).
-      Mat9 HJ = Mat9::Zero();
-      HJ.block<3, 3>(0, 3) = -hat(F.col(2));
-      HJ.block<3, 3>(0, 6) = hat(F.col(1));
-      HJ.block<3, 3>(3, 0) = hat(F.col(2));
-      HJ.block<3, 3>(3, 6) = -hat(F.col(0));
-      HJ.block<3, 3>(6, 0) = -hat(F.col(1));
-      HJ.block<3, 3>(6, 3) = hat(F.col(0));
+      const Mat9 HJ = determinant_hessian(F);
       const Vec9 gP = vec(P_stvk), gJ = vec(cof);
       Mat9 H = dphi * H_stvk + ddphi * gP * gP.transpose() + ddvol * gJ * gJ.transpose() + dvol * HJ;
       // dvol ≤ 0 (J + 1/J ≥ 2) and ∂²J/∂F² is indefinite with spectral radius

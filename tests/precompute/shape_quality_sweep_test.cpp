@@ -142,7 +142,10 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       failed += !ok;
       EXPECT_TRUE(ok) << name << ": min dihedral " << q.min_dihedral_deg << ", " << q.num_inverted << " inverted";
     } catch (const Error& e) {
-      std::printf("SWEEP|%s|failed|-|-|-|%.2f\n", name.c_str(), t.seconds());
+      std::string why = e.what();  // one line for the table
+      for (char& c : why)
+        if (c == '|' || c == '\n') c = ' ';
+      std::printf("SWEEP|%s|failed|-|-|-|%.2f|%s\n", name.c_str(), t.seconds(), why.substr(0, 240).c_str());
       ++failed;
       ADD_FAILURE() << name << ": " << e.what();
     }

@@ -48,6 +48,12 @@ double strain_energy_density(const Mat3& F, const MaterialPoint& material, Mat3*
 /// Ψ₂(F) = ½ vec(F − I)ᵀ H₂ vec(F − I) (small-strain orthotropic elasticity;
 /// Fung saturation and the barrier have no second-order term at F = I).
 Mat9 linearized_hessian(const MaterialPoint& material);
+
+/// ∂(det F)/∂F = cofactor(F): columns f1 × f2, f2 × f0, f0 × f1.
+Mat3 determinant_gradient(const Mat3& F);
+/// ∂²(det F)/∂F² as 9x9 over vec(F) (column-major; 3x3 blocks over the columns
+/// of F: ±hat of the third column). Indefinite, spectral radius ≤ √2 ‖F‖_F.
+Mat9 determinant_hessian(const Mat3& F);
 /// The same for a material and frame given separately (builds the MaterialPoint).
 double strain_energy_density(const Mat3& F, const Mat3& frame, const RegionMaterial& material,
                              Mat3* dPsi_dF = nullptr, Mat9* d2Psi_dF2 = nullptr, bool project_psd = false);

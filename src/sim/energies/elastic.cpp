@@ -6,6 +6,7 @@
 
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/sim/compression_guard.hpp"
 #include "sflsh/sim/energies/sample_hessian.hpp"
 #include "sflsh/sim/linearized_stiffness.hpp"
 
@@ -121,6 +122,9 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
       psi -= 0.5 * h.dot(H2h);
       if (grad) P -= Eigen::Map<const Mat3>(H2h.data());
       if (hess) H -= H2;
+      if (mean_dilatation_)  // the averaged bulk share, given back beyond the onset (compression_guard.hpp)
+        psi += compression_guard(F, (1.0 - kPerTetVolumeShare) * material_[k].kappa, kCompressionGuardOnset,
+                                 grad ? &P : nullptr, hess ? &H : nullptr, project_psd_);
     }
     const double w = weight_[k];
     E += w * psi;
