@@ -46,6 +46,7 @@ def main():
     ap.add_argument("--ways", default="serial,jobs2,dask1,dask2")
     ap.add_argument("--suffix", default="", help="appended to the result file names (e.g. _omp1)")
     args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
     sflsh = os.path.abspath(args.sflsh)
     opts = ["--handles", str(args.handles)]
     work = tempfile.mkdtemp(prefix="sflsh-batch-bench-")
@@ -114,7 +115,7 @@ def main():
     with open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix), "w") as f:
         f.write("# Batch precompute benchmark\n\n")
         f.write("`%s/usr/bin/python3 scripts/batch_benchmark.py --shapes %d --handles %d%s` on %s, %d cores "
-                "(shared with other users' builds: load average %.1f-%.1f during the runs, so wall times are noisy).\n\n"
+                "(1-min load average %.1f-%.1f during the runs, this benchmark's own processes included).\n\n"
                 % ("OMP_NUM_THREADS=%s " % os.environ["OMP_NUM_THREADS"] if "OMP_NUM_THREADS" in os.environ else "",
                    args.shapes, args.handles, " --ways %s --suffix %s" % (args.ways, args.suffix) if args.suffix else "",
                    os.uname().nodename, os.cpu_count(),

@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/io/input_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
@@ -22,10 +23,12 @@ struct InspectArgs {
 /// A result file (it has /frames): its summary; "incomplete" when the run stopped early.
 bool inspect_result(const InspectArgs& args) {
   bool is_result = false;
-  {
+  auto sniff = [&] {
     const io::Hdf5File f(args.path, io::Hdf5File::Mode::Read);
-    is_result = f.has("/frames") && f.has("/meta/format_version");
-  }
+    return f.has("/frames") && f.has("/meta/format_version");
+  };
+  io::probe_in_child_process(args.path, [&] { sniff(); });  // libhdf5 may crash on a damaged file
+  is_result = sniff();
   if (!is_result) return false;
   const SimulationResult r = read_simulation_result(args.path);
   if (args.json) {

@@ -19,7 +19,7 @@ struct StressArgs {
   std::string avatar, motion = "builtin:shake", dt = "1/30", out = "stress";
   long steps = 10000;
   double speed = 1;
-  bool mean_dilatation = false;
+  bool mean_dilatation = StressOptions().mean_dilatation;
 };
 
 struct SuiteArgs {
@@ -110,7 +110,7 @@ const CommandRegistrar reg(55, [](CLI::App& app) {
   cmd->add_option("--steps", a->steps, "Number of time steps")->capture_default_str();
   cmd->add_option("--out", a->out, "Output folder (stress.csv, stress.svg)")->capture_default_str();
   cmd->add_flag("--mean-dilatation,!--volume-per-tet", a->mean_dilatation,
-                "Average the elastic volume change per cell (opt-in, as `simulate --mean-dilatation`)");
+                "Average the elastic volume change per cell (the default; as `simulate --mean-dilatation`)");
   cmd->callback([a] { run_stress_command(*a); });
 });
 

@@ -4,6 +4,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 
 namespace sflsh {
 namespace {
@@ -105,7 +106,7 @@ void write_avatar(const Avatar& a, const std::string& path) {
   f.commit();
 }
 
-Avatar read_avatar(const std::string& path) {
+static Avatar read_avatar_in_this_process(const std::string& path) {
   Hdf5File f(path, Hdf5File::Mode::Read);
   Avatar a;
   if (!f.has("/meta/format_version")) fail(path, ": not an sflsh avatar file (dataset /meta/format_version is missing)");
@@ -233,6 +234,12 @@ void validate_avatar(const Avatar& a, const std::string& where) {
             "/elements indexes outside [0, ", T, ")");
     require(c->size() == 0 || c->weights.minCoeff() >= 0, where, ": ", name, "/weights must be non-negative");
   }
+}
+
+Avatar read_avatar(const std::string& path) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_avatar_in_this_process(path); });
+  return read_avatar_in_this_process(path);
 }
 
 }  // namespace sflsh

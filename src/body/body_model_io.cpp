@@ -18,6 +18,7 @@
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/npz.hpp"
 
 namespace sflsh {
@@ -246,7 +247,7 @@ class Fnv64 {
 
 }  // namespace
 
-BodyModel read_body_model_hdf5(const std::string& path) {
+static BodyModel read_body_model_hdf5_in_this_process(const std::string& path) {
   Hdf5Source src(path);
   if (src.has("meta/format_version")) {
     const double version = src.file().read_scalar("/meta/format_version");
@@ -359,6 +360,12 @@ std::string body_model_hash(const BodyModel& model) {
   h.text("joint_names");
   for (const auto& n : model.joint_names) h.text(n);
   return h.hex();
+}
+
+BodyModel read_body_model_hdf5(const std::string& path) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_body_model_hdf5_in_this_process(path); });
+  return read_body_model_hdf5_in_this_process(path);
 }
 
 }  // namespace sflsh

@@ -20,6 +20,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/ply_structure.hpp"
 #include "sflsh/io/surface_normals.hpp"
 
@@ -308,20 +309,28 @@ ImportedMesh read_mesh(const std::string& path) {
       check_ply_structure(bytes, path);
     }
   }
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(path, kImportSteps);
-  if (!scene) fail(path, ": cannot read mesh: ", importer.GetErrorString());
-  return imported_triangles(scene, path);
+  auto read = [&] {
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, kImportSteps);
+    if (!scene) fail(path, ": cannot read mesh: ", importer.GetErrorString());
+    return imported_triangles(scene, path);
+  };
+  probe_in_child_process(path, [&] { read(); });
+  return read();
 }
 
 ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std::string& format,
                                    const std::string& name) {
   require(size > 0, name, ": empty mesh file");
   check_ply_structure(std::string_view(static_cast<const char*>(data), size), name);
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
-  if (!scene) fail(name, ": cannot read mesh: ", importer.GetErrorString());
-  return imported_triangles(scene, name);
+  auto read = [&] {
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
+    if (!scene) fail(name, ": cannot read mesh: ", importer.GetErrorString());
+    return imported_triangles(scene, name);
+  };
+  probe_in_child_process(name, [&] { read(); });
+  return read();
 }
 
 }  // namespace sflsh::io

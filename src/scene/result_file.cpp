@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 
 namespace sflsh {
 namespace {
@@ -235,7 +236,7 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
   w.finish(r);
 }
 
-SimulationResult read_simulation_result(const std::string& path) {
+static SimulationResult read_simulation_result_in_this_process(const std::string& path) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
   require(f.has("/meta/format_version"), path, ": not an sflsh result file (dataset /meta/format_version is missing)");
   const double v = f.read_scalar("/meta/format_version");
@@ -337,6 +338,12 @@ SimulationResult read_simulation_result(const std::string& path) {
     (o == 0 ? r.accepted : o == 1 ? r.damped : r.rejected)++;
   }
   return r;
+}
+
+SimulationResult read_simulation_result(const std::string& path) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_simulation_result_in_this_process(path); });
+  return read_simulation_result_in_this_process(path);
 }
 
 }  // namespace sflsh

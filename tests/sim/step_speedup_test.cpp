@@ -97,7 +97,7 @@ TEST(StepSpeedup, ElasticHessianEqualsTheDenseSampleSum) {
   std::mt19937 rng(5);
   const VecX z = VecX::NullaryExpr(a->num_reduced(), [&] { return std::normal_distribution<double>(0, 0.004)(rng); });
   for (bool exact_quadratic : {false, true}) {
-    const ElasticTerm term(*a, true, exact_quadratic);
+    const ElasticTerm term(*a, true, exact_quadratic, /*mean_dilatation=*/false);  // the samples alone (no guard)
     StepContext ctx = context(*a, false);
     const auto cache = begin_term_step(term, ctx);  // the State's scratch, as in a step
     Configuration q;

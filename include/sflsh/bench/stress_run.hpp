@@ -27,8 +27,8 @@ struct StressOptions {
   /// The simulated pelvis may be at most this far from the motion's root
   /// after any step (mm; scripts/mocap_check.sh's 20 mm). ≤ 0: not checked.
   double pelvis_tolerance_mm = 20;
-  /// Mean dilatation in the elastic term (SimulatorOptions::mean_dilatation; opt-in).
-  bool mean_dilatation = false;
+  /// Mean dilatation in the elastic term (SimulatorOptions::mean_dilatation, the default).
+  bool mean_dilatation = true;
 };
 
 struct StressWindow {

@@ -20,7 +20,7 @@ struct SimulatorOptions {
   /// Stiffness-proportional damping β (s) of the soft tissue; 0 = none.
   double damping = 0.0;
   /// Mean dilatation per cell in the small-strain elastic energy (SoftTissueOptions).
-  bool mean_dilatation = false;
+  bool mean_dilatation = true;
   /// Add the soft-tissue terms (inertia, elastic, gravity if |g| > 0, damping if β > 0).
   bool soft_tissue_terms = true;
   /// Newton iterations, line search, step caps, regularization (newton_step.hpp);

@@ -52,7 +52,7 @@ class ElasticSensitivity {
   /// The elastic term's samples and materials for `avatar` (as ElasticTerm(avatar)
   /// builds them) and ∂K/∂p for each of `params`; `mean_dilatation` as the
   /// ElasticTerm's (ElasticTerm::mean_dilatation()).
-  ElasticSensitivity(const Avatar& avatar, std::vector<RegionParameter> params, bool mean_dilatation = false);
+  ElasticSensitivity(const Avatar& avatar, std::vector<RegionParameter> params, bool mean_dilatation = true);
 
   const std::vector<RegionParameter>& params() const { return params_; }
   /// ∂K/∂p_i (3K by 3K, N/m per unit of the parameter) of params()[i].

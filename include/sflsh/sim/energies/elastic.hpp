@@ -30,9 +30,10 @@ class ElasticTerm : public EnergyTerm {
   /// `mean_dilatation` (with exact_quadratic) averages the volume change of
   /// Ψ₂ over cells of tets (linearized_stiffness.hpp): the subspace no longer
   /// locks on the near-incompressible tissue (bench: rel_err 0.33 → 0.20 on jump;
-  /// keeps kPerTetVolumeShare of each tet's own volume change; opt-in).
+  /// keeps kPerTetVolumeShare of each tet's own volume change, and the samples
+  /// carry the compression guard (compression_guard.hpp); the default).
   explicit ElasticTerm(const Avatar& avatar, bool project_psd = true, bool exact_quadratic = true,
-                       bool mean_dilatation = false);
+                       bool mean_dilatation = true);
   std::string name() const override { return "elastic"; }
   BodyBlocks blocks() const override { return BodyBlocks::Soft; }
   /// Scratch of the Hessian assembly (kept in the State: no allocation per step).
