@@ -75,21 +75,13 @@ TEST(CompressionGuard, HessianMatchesFiniteDifferencesAndItsProjectionMajorizesI
   EXPECT_GE(active, 10);
 }
 
-StepContext z_only_context(const Avatar& a) {
-  StepContext ctx;
-  ctx.avatar = &a;
-  ctx.layout.bones_dynamic = false;
-  ctx.layout.num_reduced = a.num_reduced();
-  return ctx;
-}
-
 TEST(CompressionGuard, MeanDilatationTermMatchesFiniteDifferencesUnderStrongCompression) {
   test::SyntheticAvatarOptions o;
   o.nx = 1, o.ny = 2, o.nz = 1;
   o.handles = 5;
   const Avatar a = test::make_synthetic_avatar(o);
   const ElasticTerm term(a, /*project_psd=*/false, /*exact_quadratic=*/true, /*mean_dilatation=*/true);
-  const StepContext ctx = z_only_context(a);
+  const StepContext ctx = test::soft_step_context(a, false);
   // Squeeze every handle towards the slab's centre: the samples lose 20-40 % of their volume.
   Vec3 centre = a.handles.colwise().mean().transpose();
   Configuration q;
