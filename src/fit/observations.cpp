@@ -7,11 +7,12 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/point_cache.hpp"
 
 namespace sflsh {
 
-Observations read_observations(const std::string& path, double pc2_fps) {
+static Observations read_observations_in_this_process(const std::string& path, double pc2_fps) {
   require(std::filesystem::exists(path), path, ": observed file not found");
   Observations obs;
   obs.path = path;
@@ -96,6 +97,12 @@ void add_gaussian_noise(Observations& obs, double sigma, unsigned seed) {
   std::normal_distribution<double> n(0.0, sigma);
   for (Points& P : obs.positions)
     for (long i = 0; i < P.size(); ++i) P.data()[i] += n(rng);
+}
+
+Observations read_observations(const std::string& path, double pc2_fps) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_observations_in_this_process(path, pc2_fps); });
+  return read_observations_in_this_process(path, pc2_fps);
 }
 
 }  // namespace sflsh

@@ -6,6 +6,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 
 namespace sflsh::geometry {
 namespace {
@@ -135,7 +136,7 @@ void write_grid_sdf(const GridSdf& grid, const std::string& path) {
   f.commit();
 }
 
-GridSdf read_grid_sdf(const std::string& path) {
+static GridSdf read_grid_sdf_in_this_process(const std::string& path) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
   require(f.has("/meta/format") && f.read_string("/meta/format") == kFormat, path,
           ": /meta/format is not '", kFormat, "' (not a grid SDF file)");
@@ -148,6 +149,12 @@ GridSdf read_grid_sdf(const std::string& path) {
   require(dims.minCoeff() >= 2, path, ": /sdf/dims must be >= 2 along every axis, got ", dims.transpose());
   std::vector<double> values = f.read_nd("/sdf/values", {dims.z(), dims.y(), dims.x()});
   return GridSdf(origin, spacing, dims, std::move(values));
+}
+
+GridSdf read_grid_sdf(const std::string& path) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_grid_sdf_in_this_process(path); });
+  return read_grid_sdf_in_this_process(path);
 }
 
 }  // namespace sflsh::geometry

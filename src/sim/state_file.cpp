@@ -4,6 +4,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 
 namespace sflsh {
 namespace {
@@ -50,7 +51,7 @@ void write_state(const std::string& path, const Model& model, const State& state
   f.commit();
 }
 
-State read_state(const std::string& path, const Model& model) {
+static State read_state_in_this_process(const std::string& path, const Model& model) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
   require(f.has("/meta/kind") && f.read_string("/meta/kind") == "sflsh state", path,
           ": not an sflsh state file (/meta/kind is missing or not \"sflsh state\")");
@@ -83,6 +84,12 @@ State read_state(const std::string& path, const Model& model) {
     fail(path, ": ", e.what());
   }
   return s;
+}
+
+State read_state(const std::string& path, const Model& model) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { read_state_in_this_process(path, model); });
+  return read_state_in_this_process(path, model);
 }
 
 }  // namespace sflsh

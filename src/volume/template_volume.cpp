@@ -13,6 +13,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/surface_query.hpp"
 
@@ -438,7 +439,7 @@ void save_template_volume(const TemplateVolume& tv, const std::string& path) {
   h5.commit();
 }
 
-TemplateVolume load_template_volume(const std::string& path) {
+static TemplateVolume load_template_volume_in_this_process(const std::string& path) {
   io::Hdf5File h5(path, io::Hdf5File::Mode::Read);
   const std::string g = "/template/";
   TemplateVolume tv;
@@ -494,6 +495,12 @@ TemplateVolume load_template_volume(const std::string& path) {
   for (const auto& s : tv.segments)
     require(s.joint >= 0 && s.joint < J && s.child < J, path, ": dataset ", g, "segments/joints out of range");
   return tv;
+}
+
+TemplateVolume load_template_volume(const std::string& path) {
+  // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
+  io::probe_in_child_process(path, [&] { load_template_volume_in_this_process(path); });
+  return load_template_volume_in_this_process(path);
 }
 
 }  // namespace sflsh
