@@ -36,14 +36,15 @@ void probe_in_child_process(const std::string& what, const std::function<void()>
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) return;
   }
-  if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    fail(what, ": damaged file: parsing it crashed the reader library (", strsignal(sig),
-         ") in a separate process; nothing was read");
-  }
-  // Any other exit (a sanitizer's report exits with 1, for one) is a crash too.
-  if (!WIFEXITED(status) || (WEXITSTATUS(status) != kProbeRead && WEXITSTATUS(status) != kProbeThrew))
-    fail(what, ": damaged file: its reader process ended abnormally (status ", status, ")");
+  std::string how;
+  if (WIFSIGNALED(status))
+    how = strsignal(WTERMSIG(status));
+  else if (!WIFEXITED(status))
+    how = "status " + std::to_string(status);
+  else if (WEXITSTATUS(status) != kProbeRead && WEXITSTATUS(status) != kProbeThrew)
+    how = "exit code " + std::to_string(WEXITSTATUS(status)) + ", e.g. a sanitizer's report";  // ASan exits with 1
+  if (!how.empty())
+    fail(what, ": damaged file: parsing it crashed the reader library (", how, ") in a separate process; nothing was read");
 }
 
 }  // namespace sflsh::io
