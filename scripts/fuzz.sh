@@ -4,6 +4,10 @@
 #   FUZZ_RUNS=1000000 scripts/fuzz.sh 1800 ... stops a target at 10^6 executions or 30 min,
 #   whichever comes first (the reliability issue's budget per target).
 #   FUZZ_JOBS=N fuzzes N targets at a time (one core each).
+#   The readers' crash probe (io/crash_isolation.hpp) is off (SFLSH_READ_IN_PROCESS=1) so that
+#   every crash, ours or a library's, stops the fuzzer; SFLSH_READ_IN_PROCESS=0 fuzzes the
+#   product as shipped: a crash in the forked child is then an error, and the child's sanitizer
+#   report is in the target's log (grep it: a frame in sflsh:: above the library is ours).
 #   FUZZ_TIMEOUT=S sets the per-input time limit (default 10 s); on a machine whose other jobs
 #   starve the fuzzer, a 10 s wall-clock limit reports false timeouts (replay them to check).
 # Targets (fuzz/fuzz_targets.hpp): bvh npz body_model_h5 avatar_h5 result_h5 material
@@ -104,7 +108,7 @@ run_target() {
   local before
   before=$(ls "$OUT/crashes/$t" | wc -l)
   local status=0
-  (cd "$OUT" && SFLSH_READ_IN_PROCESS=1 ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}$asan_extra" LSAN_OPTIONS="suppressions=$ROOT/fuzz/lsan.supp" \
+  (cd "$OUT" && SFLSH_READ_IN_PROCESS="${SFLSH_READ_IN_PROCESS:-1}" ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}$asan_extra" LSAN_OPTIONS="suppressions=$ROOT/fuzz/lsan.supp" \
      "$OUT/${t}_fuzz" -max_total_time="$SECONDS_TO_RUN" ${FUZZ_RUNS:+-runs="$FUZZ_RUNS"} \
      -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 -malloc_limit_mb="$malloc_limit" -print_final_stats=1 \
      -artifact_prefix="$OUT/crashes/$t/" "$OUT/corpus/$t" "$OUT/seeds/$t" "$OUT/crashes/$t" "${regressions[@]}" \
