@@ -33,6 +33,7 @@ struct SimulateArgs {
   double seconds = 0, output_fps = 30, start = 0, end = -1, speed = 1, damping = 0;
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
+  int iterations_after_damping = NewtonOptions{}.iterations_after_damping;
   long inject_nan_at_step = 0;  // test only (hidden option)
   bool line_search = false, use_file_betas = false, start_at_rest = false,
        mean_dilatation = SimulatorOptions().mean_dilatation;
@@ -49,8 +50,8 @@ void check_tracking(const SimulationResult& r, const SimulateArgs& a) {
   char buf[400];
   std::snprintf(buf, sizeof buf,
                 "the pelvis strayed up to %.1f mm from the motion's root (mean %.1f mm; tolerance %.1f mm, "
-                "--tracking-tolerance); %d of %d steps were damped. Try --newton-iters 3, --max-rotation-step 0 or a "
-                "smaller --dt",
+                "--tracking-tolerance); %d of %d Newton iterations were damped. Try --newton-iters 3, "
+                "--iterations-after-damping 10, --max-rotation-step 0 or a smaller --dt",
                 r.pelvis_error_max * 1e3, r.pelvis_error_mean * 1e3, a.tracking_tolerance_mm, r.damped,
                 r.accepted + r.damped + r.rejected);
   if (a.strict) fail("simulate --strict: ", buf);
@@ -111,6 +112,9 @@ void run_simulate(const SimulateArgs& a) {
   o.sim.newton.line_search = a.line_search;
   require(std::isfinite(a.max_rotation_step), "--max-rotation-step must be finite");
   o.sim.newton.max_rotation_step = a.max_rotation_step;
+  require(a.iterations_after_damping >= 0 && a.iterations_after_damping <= 100,
+          "--iterations-after-damping must be in [0, 100], got ", a.iterations_after_damping);
+  o.sim.newton.iterations_after_damping = a.iterations_after_damping;
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
   o.sim.mean_dilatation = a.mean_dilatation;
@@ -228,6 +232,10 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--max-rotation-step", a->max_rotation_step,
                   "Largest bone rotation per Newton iteration (rad); larger steps are scaled down as a whole "
                   "(counted as damped); <= 0: no cap")
+      ->capture_default_str();
+  cmd->add_option("--iterations-after-damping", a->iterations_after_damping,
+                  "When a step's last Newton iteration is damped by a cap, up to this many more are taken, until "
+                  "one is taken in full (keeps dynamic bones on their motion; 0: none)")
       ->capture_default_str();
   cmd->add_option("--bones", a->bones, "'dynamic' (bones are DoFs tracking the motion) or 'kinematic' (prescribed)")
       ->capture_default_str();

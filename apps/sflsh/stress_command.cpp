@@ -20,6 +20,7 @@ struct StressArgs {
   long steps = 10000;
   double speed = 1;
   bool mean_dilatation = StressOptions().mean_dilatation;
+  int iterations_after_damping = StressOptions().iterations_after_damping;
 };
 
 struct SuiteArgs {
@@ -83,6 +84,9 @@ void run_stress_command(const StressArgs& a) {
   o.steps = a.steps;
   o.speed = a.speed;
   o.mean_dilatation = a.mean_dilatation;
+  require(a.iterations_after_damping >= 0 && a.iterations_after_damping <= 100,
+          "--iterations-after-damping must be in [0, 100], got ", a.iterations_after_damping);
+  o.iterations_after_damping = a.iterations_after_damping;
   require(std::isfinite(a.speed) && a.speed > 0, "--speed must be positive, got ", a.speed);
   require(a.steps >= 1, "--steps must be >= 1, got ", a.steps);
   io::check_output_folder(a.out, "--out");
@@ -111,6 +115,9 @@ const CommandRegistrar reg(55, [](CLI::App& app) {
   cmd->add_option("--out", a->out, "Output folder (stress.csv, stress.svg)")->capture_default_str();
   cmd->add_flag("--mean-dilatation,!--volume-per-tet", a->mean_dilatation,
                 "Average the elastic volume change per cell (the default; as `simulate --mean-dilatation`)");
+  cmd->add_option("--iterations-after-damping", a->iterations_after_damping,
+                  "Newton iterations added to a step whose last one was damped (as in `simulate`; 0: none)")
+      ->capture_default_str();
   cmd->callback([a] { run_stress_command(*a); });
 });
 

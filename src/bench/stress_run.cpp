@@ -46,6 +46,7 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
   ro.sim.h = o.dt;
   ro.sim.bones_dynamic = true;
   ro.sim.mean_dilatation = o.mean_dilatation;
+  ro.sim.newton.iterations_after_damping = o.iterations_after_damping;
   ro.seconds = std::min(double(o.steps) * o.dt, motion.duration());
   ro.output_fps = 10;  // frames are not kept and not used: the step callback records everything
   ro.keep_frames = false;

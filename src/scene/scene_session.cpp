@@ -282,6 +282,7 @@ void SceneSession::Impl::build() {
   mo.gravity = sc.solver.gravity;
   mo.newton.iterations = sc.solver.newton_iterations;
   mo.newton.line_search = sc.solver.line_search;
+  mo.newton.iterations_after_damping = sc.solver.iterations_after_damping;
   ModelBuilder mb(mo);
   auto in_body_contact = [&](const BodyDescription& d) {
     for (const BodyDescription& other : sc.bodies)

@@ -151,7 +151,10 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
   MatX H;
   std::vector<double> per_term, term_ms;
   bool final_valid = false;  // g_final/per_term hold the final configuration's values
-  for (int it = 0; it < o.iterations; ++it) {
+  require(o.iterations_after_damping >= 0, "NewtonOptions::iterations_after_damping = ", o.iterations_after_damping,
+          ", expected >= 0");
+  int planned = o.iterations;  // grows while the last iteration is damped (iterations_after_damping)
+  for (int it = 0; it < planned; ++it) {
     Timer ta;
     const double E0 = total_energy(sys, q, &g, &H, nullptr, &term_ms);
     rep.ms_assemble += ta.ms();
@@ -195,15 +198,20 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     }
     std::vector<Configuration> trial;
     bool ok = false;
+    // An iteration added after a damped one must lower the step's objective (Armijo):
+    // without that, on targets jumping ~3 rad (builtin:torture) the added iterations
+    // carried the bones through in one step and crushed the flesh they drag.
+    const bool added = it >= o.iterations;
+    const bool line_search = o.line_search || added;
     // On the last iteration the trial evaluation doubles as the final report's.
-    const bool last = it + 1 == o.iterations && o.report_final;
+    const bool last = it + 1 == planned && o.report_final;
     for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
       trial = retract_all(q, alpha * delta, sys.bodies);
       const double E1 =
           total_energy(sys, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr, &term_ms);
       final_valid = last;
       const bool admissible = std::isfinite(E1);
-      if (o.line_search ? (admissible && E1 <= E0 + kArmijo * alpha * capped_slope) : admissible) {
+      if (line_search ? (admissible && E1 <= E0 + kArmijo * alpha * capped_slope) : admissible) {
         ok = true;
         break;
       }
@@ -224,6 +232,11 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
       final_valid = false;
       break;
     }
+    // An added iteration that finds no decrease ends the step where the planned ones left it.
+    if (!ok && added) {
+      final_valid = false;
+      break;
+    }
     StepOutcome outcome;
     if (!ok) {
       final_valid = false;
@@ -239,6 +252,10 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     }
     if (int(outcome) > int(rep.outcome)) rep.outcome = outcome;
     if (!ok) break;
+    if (outcome == StepOutcome::Damped && it + 1 == planned && planned < o.iterations + o.iterations_after_damping) {
+      ++planned;
+      ++rep.iterations_after_damping;
+    }
   }
 
   rep.energy_after = rep.grad_norm_after = std::numeric_limits<double>::quiet_NaN();

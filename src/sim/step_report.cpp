@@ -16,7 +16,9 @@ const char* to_string(StepOutcome outcome) {
 std::string StepReport::summary() const {
   std::ostringstream os;
   os << "t = " << time << " s: " << iterations << " Newton iteration(s), " << to_string(outcome) << " ("
-     << accepted << " accepted, " << damped << " damped, " << rejected << " rejected)\n";
+     << accepted << " accepted, " << damped << " damped, " << rejected << " rejected";
+  if (iterations_after_damping > 0) os << "; " << iterations_after_damping << " added after a damped one";
+  os << ")\n";
   os << "  energy " << energy_before << " -> " << energy_after << " J, |grad| " << grad_norm_before << " -> "
      << grad_norm_after << ", Newton decrement " << newton_decrement << ", step scale " << step_scale << "\n";
   os << "  terms:";

@@ -110,6 +110,7 @@ class BoneTargets : public EnergyTerm {
   std::vector<Vec3> pivot_target;
   std::vector<Mat3> rotation_target;
   double k = 1e3, k_r = 10;
+  double rotation_hessian_scale = 1;  ///< < 1: the Hessian underestimates the curvature (Newton overshoots)
   std::string name() const override { return "bone_targets"; }
   BodyBlocks blocks() const override { return BodyBlocks::Bones; }
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override {
@@ -128,7 +129,7 @@ class BoneTargets : public EnergyTerm {
       }
       if (hess) {
         hess->block<6, 6>(o, o) += k * A.transpose() * A;
-        hess->block<3, 3>(o, o) += k_r * Mat3::Identity();
+        hess->block<3, 3>(o, o) += rotation_hessian_scale * k_r * Mat3::Identity();
       }
     }
     return E;
@@ -150,6 +151,7 @@ TEST(StepCap, RootTakesItsFullNewtonStepWhenADistalBoneHitsTheCap) {
   ctx.q_prev = ctx.q_prev2 = s.q;
   NewtonOptions o;
   o.max_rotation_step = 1.0;
+  o.iterations_after_damping = 0;  // the capped iteration itself (more iterations: the test below)
   for (bool line_search : {false, true}) {
     o.line_search = line_search;
     Configuration q = s.q;
@@ -172,6 +174,76 @@ TEST(StepCap, RootTakesItsFullNewtonStepWhenADistalBoneHitsTheCap) {
   EXPECT_EQ(rep.accepted, 1);
   EXPECT_LT((q.bones[1].linear() - term.rotation_target[1]).norm(), 1e-12);
   EXPECT_LT((s.pivot(q, 1) - term.pivot_target[1]).norm(), 1e-12);
+}
+
+/// A damped iteration is followed by more (NewtonOptions::iterations_after_damping)
+/// until one is taken in full: the distal bone, 2.5 rad from its target with a 1 rad
+/// cap, turns 1 + 1 + 0.5 rad in three iterations and ends on its target; the root's
+/// targets, reached in the first, stay reached. With too few extra iterations it
+/// ends the last one capped, 0.7 rad at a time.
+TEST(StepCap, IterationsAfterADampedOneCarryTheBoneToItsTarget) {
+  const TwoBones s;
+  BoneTargets term;
+  term.pivot_target = {s.pivot(s.q, 0) + Vec3(0.1, 0, 0), s.pivot(s.q, 1) + Vec3(0, 0.03, 0)};
+  term.rotation_target = {axis_angle(0.2, Vec3(0, 1, 0)) * s.q.bones[0].linear(),
+                          axis_angle(2.5, Vec3(0, 0, 1)) * s.q.bones[1].linear()};
+  Avatar skeleton;
+  skeleton.parents = {-1, 0};
+  StepContext ctx;
+  ctx.avatar = &skeleton;
+  ctx.layout = s.layout;
+  ctx.q_prev = ctx.q_prev2 = s.q;
+  NewtonOptions o;
+  o.max_rotation_step = 1.0;
+  ASSERT_EQ(o.iterations_after_damping, 3) << "the default this test documents";
+  Configuration q = s.q;
+  StepReport rep = newton_minimize({&term}, ctx, q, o);
+  EXPECT_EQ(rep.iterations, 3) << rep.summary();
+  EXPECT_EQ(rep.iterations_after_damping, 2);
+  EXPECT_EQ(rep.damped, 2);
+  EXPECT_EQ(rep.accepted, 1);
+  EXPECT_EQ(rep.step_scale, 1.0);
+  EXPECT_LT((q.bones[1].linear() - term.rotation_target[1]).norm(), 1e-12);
+  EXPECT_LT((s.pivot(q, 1) - term.pivot_target[1]).norm(), 1e-12);
+  EXPECT_LT((q.bones[0].linear() - term.rotation_target[0]).norm(), 1e-12);
+  EXPECT_LT((s.pivot(q, 0) - term.pivot_target[0]).norm(), 1e-12);
+  EXPECT_NEAR(rep.energy_after, 0.0, 1e-18) << "the final report is of the final configuration";
+
+  // Cap 0.7 rad, 1 + 2 iterations: 2.1 of the 2.5 rad, every iteration damped.
+  o.max_rotation_step = 0.7;
+  o.iterations_after_damping = 2;
+  q = s.q;
+  rep = newton_minimize({&term}, ctx, q, o);
+  EXPECT_EQ(rep.iterations, 3) << rep.summary();
+  EXPECT_EQ(rep.damped, 3);
+  EXPECT_LT((q.bones[1].linear() - axis_angle(2.1, Vec3(0, 0, 1)) * s.q.bones[1].linear()).norm(), 1e-12);
+  const double phi = rotation_log(q.bones[1].linear() * term.rotation_target[1].transpose()).norm();
+  EXPECT_NEAR(rep.energy_after, 0.5 * term.k_r * phi * phi, 1e-12) << "0.4 rad left on the capped bone";
+
+  // Added iterations must lower the objective. With a Hessian 4× too soft in rotation,
+  // the bone 0.5 rad from its target is sent 2 rad, capped to 1 (the planned iteration:
+  // damped, past the target by 0.5 rad); without the decrease test every added iteration
+  // would swing it back and forth between 0 and 1 rad. With it, the first added one is
+  // halved onto the target, and the next finds nothing left to do.
+  term.rotation_target[1] = axis_angle(0.5, Vec3(0, 0, 1)) * s.q.bones[1].linear();
+  term.rotation_hessian_scale = 0.25;
+  o.max_rotation_step = 1.0;
+  o.iterations_after_damping = 3;
+  q = s.q;
+  rep = newton_minimize({&term}, ctx, q, o);
+  EXPECT_EQ(rep.rejected, 0) << rep.summary();
+  EXPECT_LT((q.bones[1].linear() - term.rotation_target[1]).norm(), 1e-12) << rep.summary();
+  EXPECT_NEAR(rep.energy_after, 0.0, 1e-18);
+  term.rotation_hessian_scale = 1;
+  term.rotation_target[1] = axis_angle(2.5, Vec3(0, 0, 1)) * s.q.bones[1].linear();
+
+  // A step that is not damped takes exactly the planned iterations.
+  o.max_rotation_step = 3.0;
+  q = s.q;
+  rep = newton_minimize({&term}, ctx, q, o);
+  EXPECT_EQ(rep.iterations, 1);
+  EXPECT_EQ(rep.iterations_after_damping, 0);
+  EXPECT_EQ(rep.accepted, 1);
 }
 
 }  // namespace

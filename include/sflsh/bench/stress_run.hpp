@@ -29,6 +29,8 @@ struct StressOptions {
   double pelvis_tolerance_mm = 20;
   /// Mean dilatation in the elastic term (SimulatorOptions::mean_dilatation, the default).
   bool mean_dilatation = true;
+  /// NewtonOptions::iterations_after_damping (0: a damped step stays damped, as before).
+  int iterations_after_damping = NewtonOptions{}.iterations_after_damping;
 };
 
 struct StressWindow {

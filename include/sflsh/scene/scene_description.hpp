@@ -17,6 +17,7 @@
 //     seconds: 3                # simulated time (s, >= 0); default 0 = the longest body
 //                               # motion (then some body needs a motion)
 //     newton_iters: 1           # Newton iterations per step, 1..100; default 1
+//     iterations_after_damping: 3  # more iterations while the last one is damped by a cap, 0..100; default 3
 //     line_search: false        # backtracking line search; default false
 //     gravity: [0, -9.81, 0]    # m/s^2, world, Y up; default [0, -9.81, 0]
 //     damping: 0                # stiffness-proportional soft-tissue damping (s, >= 0); default 0
@@ -117,6 +118,7 @@
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/sim/newton_step.hpp"
 
 namespace sflsh {
 
@@ -257,6 +259,7 @@ struct SolverDescription {
   double dt = 1.0 / 60.0;               ///< s
   double seconds = 0;                   ///< s; 0 = the longest body motion
   int newton_iterations = 1;
+  int iterations_after_damping = NewtonOptions{}.iterations_after_damping;  ///< NewtonOptions'
   bool line_search = false;
   Vec3 gravity = Vec3(0, -9.81, 0);     ///< m/s²
   double damping = 0;                   ///< s

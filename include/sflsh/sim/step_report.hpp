@@ -45,6 +45,9 @@ struct StepReport {
   double regularization = 0;          ///< relative diagonal shift ε of the last solve (H_ii(1 + ε); 0 = none)
   int iterations = 0;                 ///< Newton iterations performed
   int accepted = 0, damped = 0, rejected = 0;  ///< per-iteration outcome counts
+  /// Of `iterations`, those added because the planned last one was damped
+  /// (NewtonOptions::iterations_after_damping).
+  int iterations_after_damping = 0;
   StepOutcome outcome = StepOutcome::Accepted;  ///< worst outcome over the iterations
   double ms_assemble = 0;             ///< ms evaluating energies, gradients, Hessians
   double ms_solve = 0;                ///< ms in the Cholesky factorization and solve
