@@ -251,9 +251,17 @@ void write_mesh(const std::string& path, const Points& V, const Triangles& F, co
 namespace {
 
 // ValidateDataStructure first: the other steps index out of bounds on a damaged
-// file (a face index past the vertex count; found by scripts/fuzz.sh).
-constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices | aiProcess_Triangulate |
-                                  aiProcess_PreTransformVertices;
+// file (a face index past the vertex count; found by scripts/fuzz.sh). No
+// aiProcess_Triangulate: on damaged faces it aborts the process on an internal
+// assert (assimp 5.2.5, TriangulateProcess.cpp:238; found by scripts/fuzz.sh);
+// polygons are split into fans below instead.
+constexpr unsigned kImportSteps =
+    aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
+
+/// Triangles of a face: a triangle as is, a polygon of n > 3 corners as the fan
+/// (0, i, i + 1) — exact for the convex polygons mesh exporters write (quads);
+/// points and lines carry no surface (0).
+unsigned triangles_of(const aiFace& face) { return face.mNumIndices >= 3 ? face.mNumIndices - 2 : 0; }
 
 // The triangles of every mesh of `scene` (`path` names the file in errors).
 ImportedMesh imported_triangles(const aiScene* scene, const std::string& path) {
@@ -262,7 +270,7 @@ ImportedMesh imported_triangles(const aiScene* scene, const std::string& path) {
   bool any_colors = false;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     nv += scene->mMeshes[m]->mNumVertices;
-    for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f) nf += scene->mMeshes[m]->mFaces[f].mNumIndices == 3;
+    for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f) nf += triangles_of(scene->mMeshes[m]->mFaces[f]);
     any_colors |= scene->mMeshes[m]->HasVertexColors(0);
   }
   require(nf > 0, path, ": the file holds no triangles");
@@ -282,12 +290,13 @@ ImportedMesh imported_triangles(const aiScene* scene, const std::string& path) {
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      for (int k = 0; k < 3; ++k)
-        require(face.mIndices[k] < mesh->mNumVertices, path, ": a triangle refers to vertex ", face.mIndices[k],
+      if (triangles_of(face) == 0) continue;
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        require(face.mIndices[k] < mesh->mNumVertices, path, ": a face refers to vertex ", face.mIndices[k],
                 " of a mesh with ", mesh->mNumVertices, " vertices");
-      out.faces.row(fi++) << int(vbase + face.mIndices[0]), int(vbase + face.mIndices[1]),
-          int(vbase + face.mIndices[2]);
+      for (unsigned t = 0; t < triangles_of(face); ++t)
+        out.faces.row(fi++) << int(vbase + face.mIndices[0]), int(vbase + face.mIndices[t + 1]),
+            int(vbase + face.mIndices[t + 2]);
     }
     vbase += mesh->mNumVertices;
   }

@@ -46,27 +46,32 @@ std::int64_t read_integer(const unsigned char* p, int bytes, bool is_signed, boo
 
 void check_ply_structure(std::string_view bytes, const std::string& path) {
   if (bytes.substr(0, 3) != "ply") return;
-  const std::size_t end = bytes.find("end_header");
-  require(end != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
-  // The body starts right after "end_header\n" (or "\r\n"): anything else there would make a
-  // reader that skips white space and one that skips the line disagree on where it starts.
-  std::size_t body = end + std::strlen("end_header");
-  if (body < bytes.size() && bytes[body] == '\r') ++body;
-  require(body < bytes.size() && bytes[body] == '\n', path,
-          ": PLY header's end_header is not followed by a line end (truncated or damaged file?)");
-  ++body;
-
-  std::istringstream header{std::string(bytes.substr(0, end))};
-  std::string line, format;
+  // The header is lines, each starting with one of PLY's keywords, up to a line that is
+  // exactly "end_header". A damaged keyword, or "end_header" inside another line, made this
+  // walk and assimp's disagree on where the body starts: assimp then ran out of bounds or
+  // looped for minutes (scripts/fuzz.sh, mesh). So every line is checked, not searched.
+  std::string format;
   std::vector<Element> elements;
   int line_no = 0;
-  while (std::getline(header, line)) {
+  std::size_t at_line = 0, body = std::string_view::npos;
+  while (at_line < bytes.size()) {
+    const std::size_t nl = bytes.find('\n', at_line);
+    require(nl != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
+    std::string line(bytes.substr(at_line, nl - at_line));
+    at_line = nl + 1;
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+    if (line == "end_header") {
+      body = at_line;
+      break;
+    }
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
-    if (keyword == "format") {
+    if (line_no == 1) {
+      require(line == "ply", path, ": PLY file's first line is '", line.substr(0, 40), "', expected 'ply'");
+    } else if (keyword == "comment" || keyword == "obj_info") {
+    } else if (keyword == "format") {
       words >> format;
     } else if (keyword == "element") {
       Element e;
@@ -99,8 +104,14 @@ void check_ply_structure(std::string_view bytes, const std::string& path) {
         require(p.bytes > 0, path, ": PLY header line ", line_no, " '", line, "': unknown property type '", type, "'");
       }
       elements.back().properties.push_back(p);
+    } else if (keyword.rfind("end_header", 0) == 0) {
+      fail(path, ": PLY header's end_header is not followed by a line end (truncated or damaged file?)");
+    } else {
+      require(keyword.empty(), path, ": PLY header line ", line_no, " starts with '", keyword.substr(0, 40),
+              "', not a PLY keyword (ply, format, comment, obj_info, element, property, end_header): a damaged file?");
     }
   }
+  require(body != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
   require(format == "ascii" || format == "binary_little_endian" || format == "binary_big_endian", path,
           ": PLY header has no known format line (got '", format, "')");
   if (format == "ascii") return;  // assimp's text parser stops at the end of the text

@@ -19,6 +19,7 @@
 #include "sflsh/core/memory.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 
 namespace sflsh {
@@ -213,15 +214,19 @@ std::string batch_avatar_file_name(const std::string& key) { return "avatar-" + 
 bool batch_output_done(const std::string& path, const std::string& model_hash, const VecX& betas) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return false;
-  try {
+  auto check = [&] {
     const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
     if (!f.has("/meta/betas") || !f.has("/meta/model_hash")) return false;
     if (f.read_string("/meta/model_hash") != model_hash) return false;
     const MatXr b = f.read_matrix("/meta/betas");
     if (b.size() != betas.size()) return false;
     return std::equal(b.data(), b.data() + b.size(), betas.data());
+  };
+  try {
+    io::probe_in_child_process(path, [&] { check(); });  // a file that crashes libhdf5 (io/crash_isolation.hpp)
+    return check();
   } catch (const Error&) {
-    return false;  // unreadable: build it again
+    return false;  // unreadable or damaged: build it again
   }
 }
 

@@ -13,6 +13,7 @@
 #include "sflsh/core/fnv_hash.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/volume/template_volume.hpp"
 
@@ -67,18 +68,22 @@ std::string matching_template(const std::string& cache_dir, const std::string& m
   }
   std::sort(entries.begin(), entries.end());
   for (const std::string& path : entries) {
-    try {
+    auto matches = [&] {
       const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
       if (!f.has("/template/format_version") || !f.has("/template/model_hash") || !f.has("/template/tet/elements"))
-        continue;
-      if (f.read_scalar("/template/format_version") != kTemplateVolumeFormatVersion) continue;
-      if (f.read_string("/template/model_hash") != model_hash) continue;
+        return false;
+      if (f.read_scalar("/template/format_version") != kTemplateVolumeFormatVersion) return false;
+      if (f.read_string("/template/model_hash") != model_hash) return false;
       const auto shape = f.shape("/template/tet/elements");
-      if (shape.size() != 2 || shape[0] != elements.rows() || shape[1] != 4) continue;
+      if (shape.size() != 2 || shape[0] != elements.rows() || shape[1] != 4) return false;
       const auto tets = f.read_int_matrix("/template/tet/elements", elements.rows(), 4);
-      if (std::equal(tets.data(), tets.data() + tets.size(), elements.data())) return path;
+      return std::equal(tets.data(), tets.data() + tets.size(), elements.data());
+    };
+    try {
+      io::probe_in_child_process(path, [&] { matches(); });  // an entry that crashes libhdf5 is skipped
+      if (matches()) return path;
     } catch (const Error&) {
-      // An unreadable entry is not a match.
+      // An unreadable or damaged entry is not a match.
     }
   }
   return "";

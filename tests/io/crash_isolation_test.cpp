@@ -2,9 +2,11 @@
 // throws or succeeds lets the caller go on; the fuzzers' opt-out skips the probe.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/crash_isolation.hpp"
@@ -33,6 +35,28 @@ TEST(CrashIsolation, ProbesThatThrowOrSucceedReturn) {
   int touched = 0;
   io::probe_in_child_process("ok.h5", [&] { touched = 1; });
   EXPECT_EQ(touched, 0);
+}
+
+TEST(CrashIsolation, AProbeThatHangsIsStoppedAtTheLimit) {
+  setenv("SFLSH_READ_PROBE_SECONDS", "0.5", 1);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    io::probe_in_child_process("loop.ply", [] {
+      for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+    });
+    ADD_FAILURE() << "a probe that never ends was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("loop.ply: damaged file? parsing it did not finish within 0.5 s", 0), 0u) << what;
+  }
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(waited, 0.5);
+  EXPECT_LT(waited, 60.0) << "the child was not stopped";
+  // A probe within the limit returns as before; a malformed limit falls back to the default.
+  EXPECT_NO_THROW(io::probe_in_child_process("ok.h5", [] {}));
+  setenv("SFLSH_READ_PROBE_SECONDS", "-3", 1);
+  EXPECT_NO_THROW(io::probe_in_child_process("ok.h5", [] { std::this_thread::sleep_for(std::chrono::milliseconds(700)); }));
+  unsetenv("SFLSH_READ_PROBE_SECONDS");
 }
 
 TEST(CrashIsolation, FuzzersOptOut) {

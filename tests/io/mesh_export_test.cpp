@@ -213,3 +213,25 @@ TEST(JointExport, CsvAndJson) {
 
 }  // namespace
 }  // namespace sflsh::io
+
+// Polygons are split into fans by the reader itself (assimp's triangulation step aborts the
+// process on damaged faces): a unit cube of 6 quads is 12 triangles whose signed volume,
+// Σ (a · (b × c)) / 6 over the faces, is exactly 1 (closed form), with every original corner kept.
+TEST(MeshExport, QuadsAreReadAsTwoTrianglesEach) {
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+      "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  const sflsh::io::ImportedMesh m = sflsh::io::read_mesh_from_memory(obj.data(), obj.size(), "obj", "cube.obj");
+  ASSERT_EQ(m.faces.rows(), 12);
+  ASSERT_EQ(m.vertices.rows(), 8);
+  double volume = 0;
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
+    const Eigen::Vector3d a = m.vertices.row(m.faces(f, 0)), b = m.vertices.row(m.faces(f, 1)),
+                          c = m.vertices.row(m.faces(f, 2));
+    volume += a.dot(b.cross(c)) / 6;
+  }
+  EXPECT_NEAR(volume, 1.0, 1e-12);
+  // A pentagon is 3 triangles, and a line or a point carries no surface.
+  const std::string mixed = "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nf 1 2 3 4 5\nl 1 2\n";
+  EXPECT_EQ(sflsh::io::read_mesh_from_memory(mixed.data(), mixed.size(), "obj", "pentagon.obj").faces.rows(), 3);
+}

@@ -41,6 +41,12 @@ std::string binary_tetrahedron(bool big_endian, int bad_index = -1, const std::s
   return s;
 }
 
+std::string replace_first(std::string s, const std::string& what, const std::string& with) {
+  const size_t at = s.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  return at == std::string::npos ? s : s.replace(at, what.size(), with);
+}
+
 std::string error_of(const std::string& bytes) {
   try {
     io::check_ply_structure(bytes, "probe.ply");
@@ -84,6 +90,11 @@ TEST(PlyStructure, DamagedFilesAreOneErrorNamingTheFile) {
       {"ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list float int vertex_indices\nend_header\n",
        "unsupported list types"},
       {"ply\nformat binary_middle_endian 1.0\nend_header\n", "no known format line"},
+      // Header lines must start with a keyword, and end_header must be a line of its own:
+      // where this walk and assimp's disagreed on the body's start, assimp crashed or hung.
+      {"ply\nformat binary_little_endian 1.0\nelem\xae" "ent face 48\nend_header\n", "line 3 starts with 'elem"},
+      {replace_first(good, "end_header", "Aend_header\nend_header"), "line 9 starts with 'Aend_header'"},
+      {replace_first(good, "ply\n", "ply junk\n"), "first line is 'ply junk', expected 'ply'"},
       {"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nend_header\n\x01\x02",
        "declares 4000000000 rows of 4 bytes, but 2 bytes are left"},
   };
