@@ -136,19 +136,30 @@ class BoneTargets : public EnergyTerm {
   }
 };
 
-TEST(StepCap, RootTakesItsFullNewtonStepWhenADistalBoneHitsTheCap) {
-  const TwoBones s;
+/// The two bones of TwoBones as a chain (bone 1 a leaf child of the root), pulled by
+/// BoneTargets: the root 0.1 m along x and 0.2 rad about y (within the cap), bone 1's joint
+/// 3 cm up and its rotation `distal_angle` rad about z.
+struct CappedChain {
+  TwoBones s;
   BoneTargets term;
-  // The root: 0.1 m along x and 0.2 rad about y (within the cap).
-  term.pivot_target = {s.pivot(s.q, 0) + Vec3(0.1, 0, 0), s.pivot(s.q, 1) + Vec3(0, 0.03, 0)};
-  term.rotation_target = {axis_angle(0.2, Vec3(0, 1, 0)) * s.q.bones[0].linear(),
-                          axis_angle(2.0, Vec3(0, 0, 1)) * s.q.bones[1].linear()};  // 2 rad: over the 1 rad cap
-  Avatar skeleton;  // only its parent table is read: bone 1 is a leaf child of the root
-  skeleton.parents = {-1, 0};
+  Avatar skeleton;  // only its parent table is read
   StepContext ctx;
-  ctx.avatar = &skeleton;
-  ctx.layout = s.layout;
-  ctx.q_prev = ctx.q_prev2 = s.q;
+  explicit CappedChain(double distal_angle) {
+    term.pivot_target = {s.pivot(s.q, 0) + Vec3(0.1, 0, 0), s.pivot(s.q, 1) + Vec3(0, 0.03, 0)};
+    term.rotation_target = {axis_angle(0.2, Vec3(0, 1, 0)) * s.q.bones[0].linear(),
+                            axis_angle(distal_angle, Vec3(0, 0, 1)) * s.q.bones[1].linear()};
+    skeleton.parents = {-1, 0};
+    ctx.avatar = &skeleton;
+    ctx.layout = s.layout;
+    ctx.q_prev = ctx.q_prev2 = s.q;
+  }
+};
+
+TEST(StepCap, RootTakesItsFullNewtonStepWhenADistalBoneHitsTheCap) {
+  CappedChain chain(2.0);  // 2 rad: over the 1 rad cap
+  const TwoBones& s = chain.s;
+  BoneTargets& term = chain.term;
+  const StepContext& ctx = chain.ctx;
   NewtonOptions o;
   o.max_rotation_step = 1.0;
   o.iterations_after_damping = 0;  // the capped iteration itself (more iterations: the test below)
@@ -182,17 +193,10 @@ TEST(StepCap, RootTakesItsFullNewtonStepWhenADistalBoneHitsTheCap) {
 /// targets, reached in the first, stay reached. With too few extra iterations it
 /// ends the last one capped, 0.7 rad at a time.
 TEST(StepCap, IterationsAfterADampedOneCarryTheBoneToItsTarget) {
-  const TwoBones s;
-  BoneTargets term;
-  term.pivot_target = {s.pivot(s.q, 0) + Vec3(0.1, 0, 0), s.pivot(s.q, 1) + Vec3(0, 0.03, 0)};
-  term.rotation_target = {axis_angle(0.2, Vec3(0, 1, 0)) * s.q.bones[0].linear(),
-                          axis_angle(2.5, Vec3(0, 0, 1)) * s.q.bones[1].linear()};
-  Avatar skeleton;
-  skeleton.parents = {-1, 0};
-  StepContext ctx;
-  ctx.avatar = &skeleton;
-  ctx.layout = s.layout;
-  ctx.q_prev = ctx.q_prev2 = s.q;
+  CappedChain chain(2.5);
+  const TwoBones& s = chain.s;
+  BoneTargets& term = chain.term;
+  const StepContext& ctx = chain.ctx;
   NewtonOptions o;
   o.max_rotation_step = 1.0;
   ASSERT_EQ(o.iterations_after_damping, 3) << "the default this test documents";
