@@ -226,10 +226,11 @@ Trace run_peer(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, d
   return tr;
 }
 
-/// The floor trace of basis a.W: the skin displacement of the mass-weighted
+/// The floor trace of basis W (a.W by default): the skin displacement of the mass-weighted
 /// projection of each reference frame onto span(W ⊗ I₃).
-std::vector<Points> floor_trace(const Avatar& a, const Trace& ref) {
-  const SubspaceProjector proj(a.W, simulated_nodal_mass(a));
+std::vector<Points> floor_trace(const Avatar& a, const Trace& ref,
+                                const Eigen::SparseMatrix<double, Eigen::RowMajor>* W = nullptr) {
+  const SubspaceProjector proj(W ? *W : a.W, simulated_nodal_mass(a));
   std::vector<Points> out;
   for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(a, proj.project(u)));
   return out;
@@ -460,6 +461,25 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     if (diverged) label += " (diverged at step " + std::to_string(diverged) + "; error over the " + std::to_string(tr.u.size()) + " frames before)";
     add(tr, nullptr, "peer", label, 0, h, iters, false);
   }
+  // Floors of a candidate basis without simulating it (issue 13: "report the floor for the
+  // alternatives"): affine handles, 12 DoFs per handle instead of 3, on each K's handles.
+  if (wanted("affine handles"))
+    for (size_t i = 0; i < avatars.size(); ++i) {
+      const Avatar& a = *avatars[i];
+      const auto Wa = affine_handle_weights(a.W, a.tet.nodes, a.handles);
+      const std::vector<Points> fl = floor_trace(a, ref, &Wa);
+      const double nan = kNaN;
+      BenchRow r{"floor", "affine handles, K=" + std::to_string(a.num_handles()) + " (" +
+                              std::to_string(12 * a.num_handles()) + " DoFs; floor only)",
+                 a.num_handles(), h, 0, false};
+      r.ms_median = r.ms_p95 = r.speedup = r.err_mean_mm = r.err_max_mm = r.rel_err = r.peak_ratio = nan;
+      r.ms_inertia = r.ms_elastic = r.ms_solve = r.dynamic_ms_median = r.peak_mib = nan;
+      r.floor_rel_err = region_rel_errors(fl, ref.u, in_region, 1)[0];
+      const std::vector<double> ef = region_rel_errors(fl, ref.u, labels, num_regions);
+      for (int g = 0; g < num_regions; ++g)
+        if (std::isfinite(ef[size_t(g)])) r.regions.push_back({base.materials[size_t(g)].name, nan, ef[size_t(g)]});
+      rows.push_back(r);
+    }
   add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }
@@ -518,6 +538,11 @@ void write_bench_markdown(const std::vector<BenchRow>& rows, const std::string& 
     return std::isfinite(v) ? std::string(b) : std::string("–");
   };
   for (const auto& r : rows) {
+    if (r.method == "floor") {  // a basis measured by its floor alone: no simulation columns
+      f << "| " << r.method << " | " << r.label << " | " << r.handles << " | – | – | – | – | – | – | – | – | "
+        << num(r.floor_rel_err) << " | – | – | – | – |\n";
+      continue;
+    }
     const std::string split = std::isfinite(r.ms_solve)
                                   ? ms3(r.ms_inertia) + " / " + ms3(r.ms_elastic) + " / " + ms3(r.ms_solve)
                                   : std::string("–");
@@ -558,6 +583,7 @@ void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& 
   const double W = 900, H = 480, L = 80, R = 300, T = 50, B = 60;
   double xmin = 1e9, xmax = 0, ymin = 1e9, ymax = 0;
   for (const auto& r : rows) {
+    if (r.method == "floor") continue;
     xmin = std::min(xmin, std::max(r.ms_median, 1e-3));
     xmax = std::max(xmax, r.ms_median);
     if (r.method != "reference") {
@@ -589,6 +615,7 @@ void write_bench_plot_svg(const std::vector<BenchRow>& rows, const std::string& 
     << ") rotate(-90)' text-anchor='middle'>relative soft-displacement error (log)</text>\n";
   int legend = 0;
   for (const auto& r : rows) {
+    if (r.method == "floor") continue;  // no simulation: no step time, no simulated error
     std::string label, color;
     char buf[128];
     if (r.method == "reference") {

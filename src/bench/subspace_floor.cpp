@@ -33,6 +33,27 @@ MatX SubspaceProjector::coordinates(const Points& u) const {
 
 Points SubspaceProjector::project(const Points& u) const { return W_ * coordinates(u); }
 
+Eigen::SparseMatrix<double, Eigen::RowMajor> affine_handle_weights(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
+                                                                   const Points& nodes, const Points& handles) {
+  const Eigen::Index N = W.rows(), K = W.cols();
+  require(nodes.rows() == N && nodes.cols() == 3, "affine_handle_weights: ", nodes.rows(), " by ", nodes.cols(),
+          " node positions for ", N, " rows of W, expected ", N, " by 3");
+  require(handles.rows() == K && handles.cols() == 3, "affine_handle_weights: ", handles.rows(), " by ", handles.cols(),
+          " handle positions for ", K, " columns of W, expected ", K, " by 3");
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(size_t(4 * W.nonZeros()));
+  for (Eigen::Index i = 0; i < N; ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(W, i); it; ++it) {
+      const Eigen::Index k = it.col();
+      t.emplace_back(int(i), int(k), it.value());
+      for (int c = 0; c < 3; ++c)
+        t.emplace_back(int(i), int(K + 3 * k + c), it.value() * (nodes(i, c) - handles(k, c)));
+    }
+  Eigen::SparseMatrix<double, Eigen::RowMajor> out(N, 4 * K);
+  out.setFromTriplets(t.begin(), t.end());
+  return out;
+}
+
 std::vector<double> region_rel_errors(const std::vector<Points>& u, const std::vector<Points>& ref,
                                       const VecXi& region, int num_regions) {
   require(num_regions >= 0, "region errors: negative region count");

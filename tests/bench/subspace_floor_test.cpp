@@ -117,5 +117,36 @@ TEST(RegionRelErrors, HandMadeTwoFrames) {
   EXPECT_THROW(region_rel_errors(u, ref, VecXi::Zero(3), 1), Error);  // label count
 }
 
+/// Affine handles: with rows of W normalized to a partition of unity, any affine field
+/// x ↦ A x + b is reproduced exactly (floor 0), which the translational basis cannot do; the
+/// columns are laid out as documented (k: W_·k; K + 3k + c: W_·k (x_c − c_{k,c})), checked
+/// entry by entry against a hand computation.
+TEST(SubspaceFloor, AffineHandlesReproduceAffineFieldsWhereWeightsSumToOne) {
+  const int N = 50, K = 4;
+  MatX Wd = MatX(random_basis(N, K, 3));
+  for (int i = 0; i < N; ++i) Wd.row(i) /= Wd.row(i).sum();
+  const SpW W = Wd.sparseView();
+  const Points x = Points::Random(N, 3);
+  const Points c = Points::Random(K, 3);
+  const SpW Wa = affine_handle_weights(W, x, c);
+  ASSERT_EQ(Wa.rows(), N);
+  ASSERT_EQ(Wa.cols(), 4 * K);
+  const MatX Wad = MatX(Wa);
+  for (int i = 0; i < N; i += 7)
+    for (int k = 0; k < K; ++k) {
+      EXPECT_EQ(Wad(i, k), Wd(i, k));
+      for (int a = 0; a < 3; ++a) EXPECT_NEAR(Wad(i, K + 3 * k + a), Wd(i, k) * (x(i, a) - c(k, a)), 1e-15);
+    }
+  Mat3 A;
+  A << 0.01, -0.02, 0.005, 0.03, 0.002, -0.01, -0.004, 0.02, 0.015;
+  const Vec3 b(0.003, -0.001, 0.002);
+  const Points u = (x * A.transpose()).rowwise() + b.transpose();
+  const VecX mass = VecX::LinSpaced(N, 0.5, 2.0);
+  EXPECT_LT(rel_err(SubspaceProjector(Wa, mass).project(u), u), 1e-10);
+  EXPECT_GT(rel_err(SubspaceProjector(W, mass).project(u), u), 0.05) << "translations alone miss a rotation field";
+  EXPECT_THROW(affine_handle_weights(W, Points::Zero(N - 1, 3), c), Error);
+  EXPECT_THROW(affine_handle_weights(W, x, Points::Zero(K + 1, 3)), Error);
+}
+
 }  // namespace
 }  // namespace sflsh

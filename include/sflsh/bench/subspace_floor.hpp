@@ -33,6 +33,14 @@ class SubspaceProjector {
   Eigen::LDLT<MatX> gram_;  // Wᵀ M W
 };
 
+/// Weights of the affine-handle basis of the same handles (issue 13's candidate, Wang et al.
+/// 2015): u_i = Σ_k W_ik (t_k + A_k (x_i − c_k)), 12 DoFs per handle, as scalar weights for
+/// SubspaceProjector: #N by 4K, column k = W_·k (translation), column K + 3k + c =
+/// W_·k ∘ (x_c − c_{k,c}) (the c-th column of A_k). Where Σ_k W_ik = 1 every affine field
+/// x ↦ A x + b lies in its span (t_k = A c_k + b, A_k = A). `nodes` #N by 3, `handles` #K by 3.
+Eigen::SparseMatrix<double, Eigen::RowMajor> affine_handle_weights(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
+                                                                   const Points& nodes, const Points& handles);
+
 /// Relative error per region: for each r in [0, num_regions),
 ///   sqrt(Σ_f Σ_{v: region[v] = r} ‖u_f(v) − ref_f(v)‖² / Σ_f Σ_{v: region[v] = r} ‖ref_f(v)‖²)
 /// over frames f (the shorter of the two sequences) and points v with
