@@ -170,6 +170,68 @@ void Hdf5File::check_declared_size(const std::string& name, std::uint64_t count,
          "-byte file can hold (corrupted file?)");
 }
 
+void Hdf5File::check_storage(long dataset, const std::string& name, std::uint64_t bytes_needed,
+                             std::uint64_t element_bytes) const {
+  // libhdf5 1.10 copies a dataset's values for as many bytes as the datatype and shape need,
+  // without checking them against what the file says is stored: a compact dataset's buffer,
+  // an unfiltered chunk shorter than the chunk, or data past the end of the file (heap
+  // over-reads in H5VM_memcpyvv, found by scripts/fuzz.sh, and reads past a truncated file).
+  if (mode_ != Mode::Read) return;  // a file being written has no final size yet
+  Handle dcpl(H5Dget_create_plist(dataset), H5Pclose);
+  if (dcpl.id < 0) return;
+  // The end that counts is the smaller of the file's size and the end of allocated space its
+  // superblock declares: libhdf5 sizes its read buffers by the latter.
+  std::uint64_t end = file_bytes_;
+  haddr_t eoa = 0;
+  if (H5Fget_eoa(file_, &eoa) >= 0 && eoa != HADDR_UNDEF) end = std::min<std::uint64_t>(end, std::uint64_t(eoa));
+  auto require_inside = [&](haddr_t offset, std::uint64_t span, const char* what) {
+    if (std::uint64_t(offset) > end || span > end - std::uint64_t(offset))
+      fail(path_, ": dataset ", name, what, " lies at bytes ", std::uint64_t(offset), "..", std::uint64_t(offset) + span,
+           " of a file that ends at byte ", end, " (truncated or corrupted file?)");
+  };
+  const H5D_layout_t layout = H5Pget_layout(dcpl.id);
+  const std::uint64_t stored = H5Dget_storage_size(dataset);
+  if (layout == H5D_COMPACT) {  // the values sit in the object header: as many bytes as it holds
+    if (stored < bytes_needed)
+      fail(path_, ": dataset ", name, " holds ", stored, " bytes of data, its shape needs ", bytes_needed,
+           " (corrupted file?)");
+  } else if (layout == H5D_CONTIGUOUS) {
+    const haddr_t offset = H5Dget_offset(dataset);
+    if (offset != HADDR_UNDEF) require_inside(offset, std::max(stored, bytes_needed), "");  // UNDEF: fill value
+  } else if (layout == H5D_CHUNKED) {
+    hsize_t dims[H5S_MAX_RANK];
+    const int rank = H5Pget_chunk(dcpl.id, H5S_MAX_RANK, dims);
+    if (rank <= 0) fail(path_, ": dataset ", name, " has an unreadable chunk layout (corrupted file?)");
+    std::uint64_t chunk_bytes = element_bytes;
+    for (int d = 0; d < rank; ++d) {
+      if (dims[d] == 0 || chunk_bytes > (std::uint64_t(1) << 40) / dims[d])
+        fail(path_, ": dataset ", name, " declares chunks of an impossible size (corrupted file?)");
+      chunk_bytes *= dims[d];
+    }
+    const int filters = H5Pget_nfilters(dcpl.id);
+    Handle space(H5Dget_space(dataset), H5Sclose);
+    hsize_t num_chunks = 0;
+    if (space.id < 0 || H5Dget_num_chunks(dataset, space.id, &num_chunks) < 0)
+      fail(path_, ": dataset ", name, " has an unreadable chunk index (corrupted file?)");
+    check_declared_size(name, num_chunks, 64);
+    hsize_t coords[H5S_MAX_RANK];
+    for (hsize_t c = 0; c < num_chunks; ++c) {
+      unsigned mask = 0;
+      haddr_t addr = 0;
+      hsize_t size = 0;
+      if (H5Dget_chunk_info(dataset, space.id, c, coords, &mask, &addr, &size) < 0)
+        fail(path_, ": dataset ", name, " has an unreadable chunk ", c, " (corrupted file?)");
+      require_inside(addr, size, (" chunk " + std::to_string(c)).c_str());
+      // A chunk that no filter decodes is copied as is: it must be a whole chunk.
+      const unsigned all = filters > 0 && filters < 32 ? (1u << filters) - 1 : 0u;
+      const bool unfiltered = filters <= 0 || (all != 0 && (mask & all) == all);  // bit f set: filter f skipped
+      if (unfiltered && size < chunk_bytes)
+        fail(path_, ": dataset ", name, " chunk ", c, " holds ", size, " bytes, a chunk needs ", chunk_bytes,
+             " (corrupted file?)");
+    }
+  }
+}
+
 void Hdf5File::check_number_type(long type, const std::string& name) const {
   // Only the usual layouts: libhdf5 1.10 converts exotic ones (e.g. a
   // 32-byte float, found by scripts/fuzz.sh) past the end of its buffers.
@@ -368,6 +430,7 @@ std::vector<std::string> Hdf5File::read_strings(const std::string& name) const {
   const size_t sz = H5Tget_size(ftype.id);
   if (sz == 0) fail(path_, ": dataset ", name, " has strings of size 0");
   check_declared_size(name, std::uint64_t(n), sz + sizeof(std::string));
+  check_storage(ds.id, name, std::uint64_t(n) * sz, sz);
   std::vector<char> buf(sz * n + 1, 0);
   if (n > 0 && H5Dread(ds.id, ftype.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
     fail(path_, ": cannot read dataset ", name);
@@ -399,6 +462,7 @@ std::vector<double> Hdf5File::read_nd(const std::string& name, const std::vector
   if (!ok) fail(path_, ": dataset ", name, " has shape ", shape_str(s), ", expected ", shape_str(expected));
   check_declared_size(name, element_count(s), sizeof(double));
   const std::int64_t n = std::int64_t(element_count(s));
+  check_storage(ds.id, name, std::uint64_t(n) * H5Tget_size(ftype.id), H5Tget_size(ftype.id));
   std::vector<double> buf(n);
   if (n > 0 && H5Dread(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0)
     fail(path_, ": cannot read dataset ", name, " (truncated or corrupted file?)");

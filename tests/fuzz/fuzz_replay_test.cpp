@@ -246,3 +246,38 @@ TEST(FuzzReplay, AHugeDeclaredDatasetInATinyFileIsRejectedBeforeAllocating) {
   const io::Hdf5File g(image.name(), io::Hdf5File::Mode::Read);
   test::expect_error([&] { g.read_matrix("/nodes", -1, 3); }, {"huge-in-memory.h5", "/nodes", "declares"});
 }
+
+// libhdf5 copies a dataset's values for the bytes its shape needs, whatever the file says is
+// stored (heap over-reads found by scripts/fuzz.sh): Hdf5File checks first. A chunk written raw
+// and unfiltered, 40 bytes where the chunk needs 4 × 3 doubles = 96, is one error naming both
+// sizes; so are the fuzzers' inputs (a compact dataset holding 0 bytes, a gzip-declared chunk
+// stored unfiltered), which crashed libhdf5 in-process before.
+TEST(FuzzReplay, StoredBytesShorterThanTheShapeNeedsAreAnError) {
+  test::TempDir tmp;
+  const std::string path = tmp.file("short_chunk.h5");
+  {
+    const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hsize_t dims[2] = {4, 3};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 2, dims);
+    const hid_t ds = H5Dcreate2(file, "/short", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    const double five[5] = {1, 2, 3, 4, 5};
+    const hsize_t origin[2] = {0, 0};
+    ASSERT_GE(H5Dwrite_chunk(ds, H5P_DEFAULT, 0, origin, sizeof five, five), 0);
+    H5Dclose(ds);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+    H5Fclose(file);
+  }
+  const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
+  test::expect_error([&] { f.read_matrix("/short", 4, 3); }, {"short_chunk.h5", "/short", "chunk 0 holds 40 bytes, a chunk needs 96"});
+  const fs::path reg = fs::path(test::source_dir()) / "tests" / "fuzz_regressions";
+  test::expect_error([&] { read_avatar((reg / "avatar_h5" / "libhdf5-null-memcpy-contiguous-read.h5").string()); },
+                     {"/tet/node_weights holds 0 bytes of data"});
+  test::expect_error(
+      [&] { read_body_model_hdf5((reg / "body_model_h5" / "libhdf5-unfiltered-chunk-shorter-than-the-chunk.h5").string()); },
+      {"/posedirs chunk 0 holds 25430 bytes, a chunk needs 99360"});
+}

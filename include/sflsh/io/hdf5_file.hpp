@@ -127,6 +127,11 @@ class Hdf5File {
   long open_dataset(const std::string& name) const;  // hid_t
   // Throws unless the file type `type` (hid_t) is IEEE float32/64 or a plain integer.
   void check_number_type(long type, const std::string& name) const;
+  /// The stored bytes of a dataset must cover what its shape needs before libhdf5 copies them:
+  /// a compact dataset's buffer, each unfiltered chunk (chunks of `element_bytes` × the chunk
+  /// dims), and every contiguous block or chunk must lie inside the file (its size and its
+  /// superblock's end of allocation). Fails naming the dataset otherwise.
+  void check_storage(long dataset, const std::string& name, std::uint64_t bytes_needed, std::uint64_t element_bytes) const;
   // Throws unless `count` values of `bytes_each` bytes fit the guard above.
   void check_declared_size(const std::string& name, std::uint64_t count, std::uint64_t bytes_each) const;
   std::uint64_t file_bytes_ = 0;  // size of the file or image being read
