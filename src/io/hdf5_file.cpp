@@ -208,10 +208,21 @@ void Hdf5File::check_storage(long dataset, const std::string& name, std::uint64_
         fail(path_, ": dataset ", name, " declares chunks of an impossible size (corrupted file?)");
       chunk_bytes *= dims[d];
     }
-    const int filters = H5Pget_nfilters(dcpl.id);
+    // HDF5 requires chunks no larger than a fixed dimension; libhdf5 1.10 does not check it on
+    // read and then copies out of a decompressed chunk with the declared chunk's strides (a
+    // SEGV found by scripts/fuzz.sh: chunks of 20 × 4099 × 207 on a 20 × 3 × 207 dataset).
     Handle space(H5Dget_space(dataset), H5Sclose);
+    hsize_t cur[H5S_MAX_RANK], maxd[H5S_MAX_RANK];
+    if (space.id < 0 || H5Sget_simple_extent_ndims(space.id) != rank ||
+        H5Sget_simple_extent_dims(space.id, cur, maxd) != rank)
+      fail(path_, ": dataset ", name, " has chunks of rank ", rank, " that do not match its shape (corrupted file?)");
+    for (int d = 0; d < rank; ++d)
+      if (maxd[d] != H5S_UNLIMITED && dims[d] > std::max<hsize_t>(maxd[d], 1))
+        fail(path_, ": dataset ", name, " declares chunks of ", dims[d], " along dimension ", d, ", larger than its ",
+             maxd[d], " (corrupted file?)");
+    const int filters = H5Pget_nfilters(dcpl.id);
     hsize_t num_chunks = 0;
-    if (space.id < 0 || H5Dget_num_chunks(dataset, space.id, &num_chunks) < 0)
+    if (H5Dget_num_chunks(dataset, space.id, &num_chunks) < 0)
       fail(path_, ": dataset ", name, " has an unreadable chunk index (corrupted file?)");
     check_declared_size(name, num_chunks, 64);
     hsize_t coords[H5S_MAX_RANK];

@@ -251,7 +251,7 @@ TEST(FuzzReplay, AHugeDeclaredDatasetInATinyFileIsRejectedBeforeAllocating) {
 // stored (heap over-reads found by scripts/fuzz.sh): Hdf5File checks first. A chunk written raw
 // and unfiltered, 40 bytes where the chunk needs 4 × 3 doubles = 96, is one error naming both
 // sizes; so are the fuzzers' inputs (a compact dataset holding 0 bytes, a gzip-declared chunk
-// stored unfiltered), which crashed libhdf5 in-process before.
+// stored unfiltered, chunks larger than the dataset), which crashed libhdf5 in-process before.
 TEST(FuzzReplay, StoredBytesShorterThanTheShapeNeedsAreAnError) {
   test::TempDir tmp;
   const std::string path = tmp.file("short_chunk.h5");
@@ -280,4 +280,7 @@ TEST(FuzzReplay, StoredBytesShorterThanTheShapeNeedsAreAnError) {
   test::expect_error(
       [&] { read_body_model_hdf5((reg / "body_model_h5" / "libhdf5-unfiltered-chunk-shorter-than-the-chunk.h5").string()); },
       {"/posedirs chunk 0 holds 25430 bytes, a chunk needs 99360"});
+  test::expect_error(
+      [&] { read_body_model_hdf5((reg / "body_model_h5" / "libhdf5-chunk-larger-than-the-dataset-segv.h5").string()); },
+      {"/posedirs declares chunks of 4099 along dimension 1, larger than its 3"});
 }
