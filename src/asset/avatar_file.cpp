@@ -238,8 +238,7 @@ void validate_avatar(const Avatar& a, const std::string& where) {
 
 Avatar read_avatar(const std::string& path) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_avatar_in_this_process(path); });
-  return read_avatar_in_this_process(path);
+  return io::read_in_child_first(path, [&] { return read_avatar_in_this_process(path); });
 }
 
 }  // namespace sflsh

@@ -364,8 +364,7 @@ std::string body_model_hash(const BodyModel& model) {
 
 BodyModel read_body_model_hdf5(const std::string& path) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_body_model_hdf5_in_this_process(path); });
-  return read_body_model_hdf5_in_this_process(path);
+  return io::read_in_child_first(path, [&] { return read_body_model_hdf5_in_this_process(path); });
 }
 
 }  // namespace sflsh

@@ -101,8 +101,7 @@ void add_gaussian_noise(Observations& obs, double sigma, unsigned seed) {
 
 Observations read_observations(const std::string& path, double pc2_fps) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_observations_in_this_process(path, pc2_fps); });
-  return read_observations_in_this_process(path, pc2_fps);
+  return io::read_in_child_first(path, [&] { return read_observations_in_this_process(path, pc2_fps); });
 }
 
 }  // namespace sflsh

@@ -153,8 +153,7 @@ static GridSdf read_grid_sdf_in_this_process(const std::string& path) {
 
 GridSdf read_grid_sdf(const std::string& path) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_grid_sdf_in_this_process(path); });
-  return read_grid_sdf_in_this_process(path);
+  return io::read_in_child_first(path, [&] { return read_grid_sdf_in_this_process(path); });
 }
 
 }  // namespace sflsh::geometry

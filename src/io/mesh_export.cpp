@@ -324,8 +324,7 @@ ImportedMesh read_mesh(const std::string& path) {
     if (!scene) fail(path, ": cannot read mesh: ", importer.GetErrorString());
     return imported_triangles(scene, path);
   };
-  probe_in_child_process(path, [&] { read(); });
-  return read();
+  return read_in_child_first(path, read);
 }
 
 ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std::string& format,
@@ -338,8 +337,7 @@ ImportedMesh read_mesh_from_memory(const void* data, std::size_t size, const std
     if (!scene) fail(name, ": cannot read mesh: ", importer.GetErrorString());
     return imported_triangles(scene, name);
   };
-  probe_in_child_process(name, [&] { read(); });
-  return read();
+  return read_in_child_first(name, read);
 }
 
 }  // namespace sflsh::io

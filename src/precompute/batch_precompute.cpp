@@ -223,8 +223,7 @@ bool batch_output_done(const std::string& path, const std::string& model_hash, c
     return std::equal(b.data(), b.data() + b.size(), betas.data());
   };
   try {
-    io::probe_in_child_process(path, [&] { check(); });  // a file that crashes libhdf5 (io/crash_isolation.hpp)
-    return check();
+    return io::read_in_child_first(path, check);  // a file that crashes libhdf5 is refused (io/crash_isolation.hpp)
   } catch (const Error&) {
     return false;  // unreadable or damaged: build it again
   }

@@ -80,8 +80,7 @@ std::string matching_template(const std::string& cache_dir, const std::string& m
       return std::equal(tets.data(), tets.data() + tets.size(), elements.data());
     };
     try {
-      io::probe_in_child_process(path, [&] { matches(); });  // an entry that crashes libhdf5 is skipped
-      if (matches()) return path;
+      if (io::read_in_child_first(path, matches)) return path;  // an entry that crashes libhdf5 is skipped
     } catch (const Error&) {
       // An unreadable or damaged entry is not a match.
     }

@@ -342,8 +342,7 @@ static SimulationResult read_simulation_result_in_this_process(const std::string
 
 SimulationResult read_simulation_result(const std::string& path) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_simulation_result_in_this_process(path); });
-  return read_simulation_result_in_this_process(path);
+  return io::read_in_child_first(path, [&] { return read_simulation_result_in_this_process(path); });
 }
 
 }  // namespace sflsh

@@ -88,8 +88,7 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
 
 State read_state(const std::string& path, const Model& model) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { read_state_in_this_process(path, model); });
-  return read_state_in_this_process(path, model);
+  return io::read_in_child_first(path, [&] { return read_state_in_this_process(path, model); });
 }
 
 }  // namespace sflsh

@@ -499,8 +499,7 @@ static TemplateVolume load_template_volume_in_this_process(const std::string& pa
 
 TemplateVolume load_template_volume(const std::string& path) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  io::probe_in_child_process(path, [&] { load_template_volume_in_this_process(path); });
-  return load_template_volume_in_this_process(path);
+  return io::read_in_child_first(path, [&] { return load_template_volume_in_this_process(path); });
 }
 
 }  // namespace sflsh

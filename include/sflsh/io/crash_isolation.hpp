@@ -22,4 +22,11 @@ namespace sflsh::io {
 /// read then throws the same error). Returns without probing if fork is unavailable.
 void probe_in_child_process(const std::string& what, const std::function<void()>& probe);
 
+/// The readers' pattern: `read` probed in a child first (above), then run here; returns its result.
+template <class Read>
+auto read_in_child_first(const std::string& what, Read&& read) -> decltype(read()) {
+  probe_in_child_process(what, [&] { read(); });
+  return read();
+}
+
 }  // namespace sflsh::io
