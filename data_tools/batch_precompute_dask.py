@@ -25,7 +25,8 @@ Usage:
         [--csv results.csv] -- [sflsh precompute options: --model ... --handles ... --cache-dir ...]
 
 Without --scheduler a LocalCluster of --workers processes (1 thread each) runs on
-this machine. Needs Debian's python3-distributed.
+this machine, and each sflsh gets `--threads cores/workers`. On a cluster with one
+Dask worker per core, pass `-- --threads 1` (sflsh's default is one thread per core). Needs Debian's python3-distributed.
 """
 import argparse
 import csv
@@ -182,6 +183,10 @@ def main(argv=None):
         ap.error("%s: shapes file not found" % args.batch)
     os.makedirs(out_dir, exist_ok=True)
     out_csv = args.csv or os.path.join(out_dir, "dask_manifest.csv")
+    # The local workers share this machine's cores: each sflsh solves its weights on
+    # cores / workers threads unless the options say otherwise (sflsh precompute --threads).
+    if not args.scheduler and not any(o.split("=")[0] == "--threads" for o in options):
+        options = options + ["--threads", str(max(1, (os.cpu_count() or 1) // args.workers))]
 
     try:
         from distributed import Client, LocalCluster, as_completed

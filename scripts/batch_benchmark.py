@@ -2,8 +2,10 @@
 """Batch precompute benchmark (README "Batch precompute"): N shapes of the default
 procedural body built four ways, each into an empty folder, the template stage
 cached once beforehand:
-  serial   sflsh precompute --batch --jobs 1   (in one process, the existing loop)
-  jobs2    sflsh precompute --batch --jobs 2   (2 worker processes)
+  serial   sflsh precompute --batch --jobs 1   (in one process, the existing loop; each
+           shape's weights on one thread per core)
+  serial1  the same loop with --threads 1      (each shape on one thread)
+  jobs2    sflsh precompute --batch --jobs 2   (2 worker processes, 1 thread each)
   dask1    data_tools/batch_precompute_dask.py, LocalCluster of 1 worker
   dask2    the same with 2 workers
 Writes scripts/results/batch_benchmark.csv (one line per way), the manifests
@@ -43,7 +45,7 @@ def main():
     ap.add_argument("--shapes", type=int, default=16)
     ap.add_argument("--handles", type=int, default=16)
     ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results"))
-    ap.add_argument("--ways", default="serial,jobs2,dask1,dask2")
+    ap.add_argument("--ways", default="serial,serial1,jobs2,dask1,dask2")
     ap.add_argument("--suffix", default="", help="appended to the result file names (e.g. _omp1)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
@@ -65,9 +67,11 @@ def main():
     dirs = {}
     for way in args.ways.split(","):
         out_dir = os.path.join(work, way)
-        if way in ("serial", "jobs2"):
+        if way in ("serial", "serial1", "jobs2"):
             cmd = [sflsh, "-q", "precompute"] + opts + ["--batch", shapes, "--out-dir", out_dir,
-                                                        "--jobs", "1" if way == "serial" else "2"]
+                                                        "--jobs", "2" if way == "jobs2" else "1"]
+            if way == "serial1":
+                cmd += ["--threads", "1"]
             manifest = os.path.join(out_dir, "manifest.csv")
         else:
             cmd = ["/usr/bin/python3", os.path.join(ROOT, "data_tools", "batch_precompute_dask.py"), "--sflsh", sflsh,
@@ -103,10 +107,12 @@ def main():
                     for w in dirs for n in names)
     by = {r["way"]: r for r in rows}
     for r in rows:
-        ref = by.get("serial", r) if r["way"] in ("serial", "jobs2") else by.get("dask1", r)
+        ref = by.get("serial", r) if r["way"] in ("serial", "serial1", "jobs2") else by.get("dask1", r)
         r["speedup"] = round(ref["wall_s"] / r["wall_s"], 2)
+        if "serial1" in by:
+            r["speedup_vs_serial1"] = round(by["serial1"]["wall_s"] / r["wall_s"], 2)
     fields = ["way", "shapes", "handles", "wall_s", "wall_per_shape_s", "cpu_s", "row_seconds_mean",
-              "shape_seconds_mean", "peak_rss_mib_max", "speedup", "load_before", "load_after", "summary"]
+              "shape_seconds_mean", "peak_rss_mib_max", "speedup", "speedup_vs_serial1", "load_before", "load_after", "summary"]
     with open(os.path.join(args.out, "batch_benchmark%s.csv" % args.suffix), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
         w.writeheader()
@@ -121,12 +127,13 @@ def main():
                    os.uname().nodename, os.cpu_count(),
                    min(r["load_before"] for r in rows), max(r["load_after"] for r in rows)))
         f.write("| way | wall (s) | wall per shape (s) | CPU (s) | row time, mean (s) | peak RSS per worker (MiB) "
-                "| speed-up |\n|---|---|---|---|---|---|---|\n")
+                "| speed-up | vs serial1 |\n|---|---|---|---|---|---|---|---|\n")
         for r in rows:
-            ref = "serial" if r["way"] in ("serial", "jobs2") else "dask1"
-            f.write("| %s | %.1f | %.2f | %.1f | %.2f | %.0f | %.2f× (vs %s) |\n"
+            ref = "serial" if r["way"] in ("serial", "serial1", "jobs2") else "dask1"
+            f.write("| %s | %.1f | %.2f | %.1f | %.2f | %.0f | %.2f× (vs %s) | %s |\n"
                     % (r["way"], r["wall_s"], r["wall_per_shape_s"], r["cpu_s"], r["row_seconds_mean"],
-                       r["peak_rss_mib_max"], r["speedup"], ref))
+                       r["peak_rss_mib_max"], r["speedup"], ref,
+                       "%.2f×" % r["speedup_vs_serial1"] if "speedup_vs_serial1" in r else "-"))
         f.write("\nTemplate stage computed once (cache entry %s %s during the runs); the %d ways wrote %s files.\n"
                 % (os.path.basename(cache), "REBUILT" if rebuilt else "not rewritten", len(rows),
                    "bit-identical" if identical else "DIFFERENT"))

@@ -395,7 +395,8 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
         }
       }
     };
-    const int workers = std::max(1, std::min<int>(C, int(std::thread::hardware_concurrency())));
+    const int cores = std::max(1, int(std::thread::hardware_concurrency()));
+    const int workers = std::max(1, std::min<int>(C, options.threads > 0 ? options.threads : cores));
     std::vector<std::thread> pool;
     if (nf > 0)
       for (int t = 0; t < workers; ++t) pool.emplace_back(worker);

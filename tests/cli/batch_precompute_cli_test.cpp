@@ -89,8 +89,9 @@ TEST_F(BatchCli, ResumedRunSkipsFinishedRowsAndMatchesAnUninterruptedRunBitForBi
 
   // A crashed run: row 1 finished (built alone, as a job-array task would),
   // row 0 left a half-written temporary file, and row 2's final name holds a
-  // file that is not an avatar (an interrupted copy, say).
-  ASSERT_EQ(run("--batch " + shapes + " --out-dir " + dir_->file("b") + " --task-index 1", &out), 0) << out;
+  // file that is not an avatar (an interrupted copy, say). Row 1 is solved on
+  // 3 weight threads here and on 1 in run a's workers: the bytes must not differ.
+  ASSERT_EQ(run("--batch " + shapes + " --out-dir " + dir_->file("b") + " --task-index 1 --threads 3", &out), 0) << out;
   EXPECT_EQ(manifest(dir_->file("b/manifest-task-1.csv"))[1].status, "built");
   const std::string f0 = dir_->file("b/" + fs::path(a[0].file).filename().string());
   const std::string f2 = dir_->file("b/" + fs::path(a[2].file).filename().string());
@@ -109,6 +110,8 @@ TEST_F(BatchCli, ResumedRunSkipsFinishedRowsAndMatchesAnUninterruptedRunBitForBi
     EXPECT_GT(fa.size(), 1000u);
     EXPECT_TRUE(fa == fb) << "row " << row << ": the resumed run's file differs from the uninterrupted run's";
   }
+  EXPECT_NE(run("--batch " + shapes + " --out-dir " + dir_->file("c") + " --threads -1", &out), 0);
+  EXPECT_NE(out.find("--threads must be in [1, 1024]"), std::string::npos) << out;
   // Nothing left to do: a third run builds nothing and succeeds.
   ASSERT_EQ(run("--batch " + shapes + " --out-dir " + dir_->file("b"), &out), 0) << out;
   EXPECT_NE(out.find("4 rows: 3 exists, 1 duplicate"), std::string::npos) << out;

@@ -112,6 +112,10 @@ struct BbwOptions {
   int max_border_columns = 200;
   /// Show a progress line (sflsh::Progress) over handles.
   bool show_progress = true;
+  /// Threads that solve the columns (each column on one thread; the result
+  /// does not depend on it); 0 = one per core. `precompute --threads`; a batch
+  /// gives each of its worker processes cores / workers.
+  int threads = 0;
 };
 
 /// What the solve did (Ceres-style summary). Residuals are dimensionless.
