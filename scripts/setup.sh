@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libcli11-dev libyaml-cpp-dev libzip-dev zlib1g-dev
   libtbb-dev libpng-dev
   libbullet-dev  # sflsh bench's peer: Bullet 3 deformable FEM (bullet-float64)
+  libspectra-dev  # sflsh bench: the soft tissue's lowest vibration modes (shift-invert Lanczos)
   python3-numpy python3-scipy python3-h5py
   python3-distributed
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer, ASan, UBSan

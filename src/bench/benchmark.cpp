@@ -12,6 +12,7 @@
 #include <string>
 
 #include "sflsh/bench/bullet_peer.hpp"
+#include "sflsh/bench/soft_tissue_modes.hpp"
 #include "sflsh/bench/subspace_floor.hpp"
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
@@ -462,24 +463,59 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     add(tr, nullptr, "peer", label, 0, h, iters, false);
   }
   // Floors of a candidate basis without simulating it (issue 13: "report the floor for the
-  // alternatives"): affine handles, 12 DoFs per handle instead of 3, on each K's handles.
+  // alternatives"): a row with the floor and its regions, the simulated figures NaN.
+  auto add_floor_only = [&](const std::vector<Points>& fl, const std::string& label, int handles) {
+    const double nan = kNaN;
+    BenchRow r{"floor", label, handles, h, 0, false};
+    r.ms_median = r.ms_p95 = r.speedup = r.err_mean_mm = r.err_max_mm = r.rel_err = r.peak_ratio = nan;
+    r.ms_inertia = r.ms_elastic = r.ms_solve = r.dynamic_ms_median = r.peak_mib = nan;
+    r.floor_rel_err = region_rel_errors(fl, ref.u, in_region, 1)[0];
+    const std::vector<double> ef = region_rel_errors(fl, ref.u, labels, num_regions);
+    for (int g = 0; g < num_regions; ++g)
+      if (std::isfinite(ef[size_t(g)])) r.regions.push_back({base.materials[size_t(g)].name, nan, ef[size_t(g)]});
+    rows.push_back(r);
+  };
+  // Affine handles: 12 DoFs per handle instead of 3, on each K's handles.
   if (wanted("affine handles"))
     for (size_t i = 0; i < avatars.size(); ++i) {
       const Avatar& a = *avatars[i];
       const auto Wa = affine_handle_weights(a.W, a.tet.nodes, a.handles);
-      const std::vector<Points> fl = floor_trace(a, ref, &Wa);
-      const double nan = kNaN;
-      BenchRow r{"floor", "affine handles, K=" + std::to_string(a.num_handles()) + " (" +
-                              std::to_string(12 * a.num_handles()) + " DoFs; floor only)",
-                 a.num_handles(), h, 0, false};
-      r.ms_median = r.ms_p95 = r.speedup = r.err_mean_mm = r.err_max_mm = r.rel_err = r.peak_ratio = nan;
-      r.ms_inertia = r.ms_elastic = r.ms_solve = r.dynamic_ms_median = r.peak_mib = nan;
-      r.floor_rel_err = region_rel_errors(fl, ref.u, in_region, 1)[0];
-      const std::vector<double> ef = region_rel_errors(fl, ref.u, labels, num_regions);
-      for (int g = 0; g < num_regions; ++g)
-        if (std::isfinite(ef[size_t(g)])) r.regions.push_back({base.materials[size_t(g)].name, nan, ef[size_t(g)]});
-      rows.push_back(r);
+      add_floor_only(floor_trace(a, ref, &Wa),
+                     "affine handles, K=" + std::to_string(a.num_handles()) + " (" +
+                         std::to_string(12 * a.num_handles()) + " DoFs; floor only)",
+                     a.num_handles());
     }
+  // The lowest vibration modes of the soft tissue with the bones held (soft_tissue_modes.hpp):
+  // alone, as many as each K's handles have DoFs, and added to the default K's handles.
+  if (wanted("vibration modes")) {
+    const std::vector<int> added = {3 * K / 4, 3 * K / 2, 3 * K};
+    int most = added.back();
+    for (const auto& a : avatars) most = std::max(most, 3 * a->num_handles());
+    log_info("bench: the " + std::to_string(most) + " lowest vibration modes of the soft tissue (bones held)");
+    const VibrationModes modes = soft_tissue_modes(base, most);
+    const VecX mass = simulated_nodal_mass(base);
+    auto trace_of = [&](const MatX& B) {
+      const VectorSubspaceProjector proj(B, mass);
+      std::vector<Points> out;
+      for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
+      return out;
+    };
+    for (const auto& a : avatars) {
+      const int m = 3 * a->num_handles();
+      add_floor_only(trace_of(modes.phi.leftCols(m)),
+                     "vibration modes only, " + std::to_string(m) + " (" + std::to_string(m) + " DoFs; floor only)",
+                     a->num_handles());
+    }
+    const MatX bbw = vector_basis(base.W);
+    for (int m : added) {
+      MatX B(bbw.rows(), bbw.cols() + m);
+      B << bbw, modes.phi.leftCols(m);
+      add_floor_only(trace_of(B),
+                     "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " vibration modes (" +
+                         std::to_string(3 * K + m) + " DoFs; floor only)",
+                     K);
+    }
+  }
   add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+
+#include <Eigen/Eigenvalues>
 
 #include "sflsh/core/error.hpp"
 
@@ -32,6 +35,44 @@ MatX SubspaceProjector::coordinates(const Points& u) const {
 }
 
 Points SubspaceProjector::project(const Points& u) const { return W_ * coordinates(u); }
+
+VectorSubspaceProjector::VectorSubspaceProjector(MatX B, const VecX& mass) : B_(std::move(B)) {
+  require(B_.rows() == 3 * mass.size(), "subspace floor: vector basis has ", B_.rows(), " rows for ", mass.size(),
+          " nodes (expected ", 3 * mass.size(), ")");
+  require(mass.allFinite() && (mass.size() == 0 || mass.minCoeff() >= 0.0),
+          "subspace floor: nodal masses must be finite and non-negative");
+  mass3_.resize(3 * mass.size());
+  for (Eigen::Index i = 0; i < mass.size(); ++i) mass3_.segment<3>(3 * i).setConstant(mass[i]);
+  const MatX G = B_.transpose() * mass3_.asDiagonal() * B_;
+  const Eigen::SelfAdjointEigenSolver<MatX> eig(G);
+  const VecX& ev = eig.eigenvalues();
+  require(ev.size() > 0 && ev.maxCoeff() > 0.0, "subspace floor: the vector basis has no weight on a node with mass");
+  const double floor = 1e-12 * ev.maxCoeff();
+  int r = 0;
+  for (Eigen::Index k = 0; k < ev.size(); ++k) r += ev[k] > floor;
+  kept_.resize(G.rows(), r);
+  for (Eigen::Index k = 0, j = 0; k < ev.size(); ++k)
+    if (ev[k] > floor) kept_.col(j++) = eig.eigenvectors().col(k) / std::sqrt(ev[k]);
+}
+
+Points VectorSubspaceProjector::project(const Points& u) const {
+  require(3 * u.rows() == B_.rows() && u.cols() == 3, "subspace floor: displacement is ", u.rows(), " by ", u.cols(),
+          ", expected ", B_.rows() / 3, " by 3");
+  const Eigen::Map<const VecX> flat(u.data(), u.size());  // Points is row-major: 3i + c
+  // c* = Q Qᵀ Bᵀ M u with Q = kept_ (G⁺ restricted to its range).
+  const VecX c = kept_ * (kept_.transpose() * (B_.transpose() * mass3_.cwiseProduct(flat)));
+  Points out(u.rows(), 3);
+  Eigen::Map<VecX>(out.data(), out.size()) = B_ * c;
+  return out;
+}
+
+MatX vector_basis(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W) {
+  MatX B = MatX::Zero(3 * W.rows(), 3 * W.cols());
+  for (int i = 0; i < W.outerSize(); ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(W, i); it; ++it)
+      for (int c = 0; c < 3; ++c) B(3 * i + c, 3 * it.col() + c) = it.value();
+  return B;
+}
 
 Eigen::SparseMatrix<double, Eigen::RowMajor> affine_handle_weights(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
                                                                    const Points& nodes, const Points& handles) {

@@ -33,6 +33,32 @@ class SubspaceProjector {
   Eigen::LDLT<MatX> gram_;  // Wᵀ M W
 };
 
+/// Projection onto the span of a general vector basis with the same mass metric:
+///   c* = argmin_c Σ_i m_i ‖u_i − (B c)_i‖²,  B 3N by D, row 3i + c = component c at node i.
+/// For bases that are not W ⊗ I₃, e.g. the handles' columns together with vibration modes
+/// (soft_tissue_modes.hpp). Columns may be linearly dependent: the normal equations are
+/// solved in the eigenbasis of Bᵀ M B, leaving out directions whose eigenvalue is below
+/// 1e-12 of the largest (the minimum-norm solution; the projection is unique either way).
+class VectorSubspaceProjector {
+ public:
+  /// `B` 3N by D, `mass` #N non-negative nodal masses (kg). Fails on wrong sizes, a
+  /// negative or non-finite mass or a basis with no weight on any node with mass.
+  VectorSubspaceProjector(MatX B, const VecX& mass);
+  /// #N by 3 best approximation B c* of `u` (#N by 3, m).
+  Points project(const Points& u) const;
+  /// The dimension of span(B) on the nodes with mass (D less the directions left out).
+  int rank() const { return int(kept_.cols()); }
+
+ private:
+  MatX B_;
+  VecX mass3_;  // 3N: mass per DoF
+  MatX kept_;   // D by r: eigenvectors of Bᵀ M B scaled by 1/sqrt(eigenvalue)
+};
+
+/// W ⊗ I₃ (#N by #K weights) as a dense 3N by 3K vector basis: column 3k + c
+/// is W_·k along axis c.
+MatX vector_basis(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W);
+
 /// Weights of the affine-handle basis of the same handles (issue 13's candidate, Wang et al.
 /// 2015): u_i = Σ_k W_ik (t_k + A_k (x_i − c_k)), 12 DoFs per handle, as scalar weights for
 /// SubspaceProjector: #N by 4K, column k = W_·k (translation), column K + 3k + c =
