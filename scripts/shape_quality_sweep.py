@@ -9,11 +9,17 @@ Runs the shape stage's geometry (shape_volume, default thickness map) on
     temporary folder with data_tools/makehuman_to_smpl.py): beta = 0, the same 32
     corners, every shape direction alone at +-3, and the 12 MakeHuman targets;
 and writes scripts/results/shape_quality.md: per shape the min dihedral angle, the
-number of inverted tets, tets below 8 deg, skin caps removed and the time. Every
+number of inverted tets, tets below 8 deg, skin caps removed, the time and, for shapes below
+the bar, whether the shaped skin itself self-intersects. Every
 shape must reach >= 8 deg with no inverted tet; the exit status is 1 otherwise.
 
 Usage: /usr/bin/python3 scripts/shape_quality_sweep.py [--build build] [--random 100]
-       [--models procedural,makehuman] [--shared ../shared] [--out scripts/results/shape_quality.md]
+       [--models procedural,makehuman] [--corners 32|all] [--no-directions] [--shared ../shared]
+       [--out scripts/results/shape_quality.md]
+--corners all takes all 1024 corners of [-3, 3]^10 (about an hour per body on one core);
+the full procedural sweep's record is scripts/results/shape_quality_all_corners.md:
+  /usr/bin/python3 scripts/shape_quality_sweep.py --models procedural --corners all --random 100 \
+      --no-directions --out scripts/results/shape_quality_all_corners.md
 Template stages come from the precompute cache (~/.cache/sflsh; built on first use).
 """
 import argparse
@@ -26,10 +32,10 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def run_sweep(binary, model, random, betas_csv=None):
+def run_sweep(binary, model, random, betas_csv=None, corners="32", directions=True):
     env = dict(os.environ)
-    env.update(SFLSH_SWEEP_MODEL=model, SFLSH_SWEEP_RANDOM=str(random), SFLSH_SWEEP_DIRECTIONS="1",
-               SFLSH_SWEEP_CORNERS="32")
+    env.update(SFLSH_SWEEP_MODEL=model, SFLSH_SWEEP_RANDOM=str(random),
+               SFLSH_SWEEP_DIRECTIONS="1" if directions else "0", SFLSH_SWEEP_CORNERS=corners)
     if betas_csv:
         env["SFLSH_SWEEP_BETAS"] = betas_csv
     t0 = time.time()
@@ -53,6 +59,9 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--random", type=int, default=100)
     ap.add_argument("--models", default="procedural,makehuman")
+    ap.add_argument("--corners", default="32", choices=["32", "all", "0"],
+                    help="32: every sign pattern of beta0..3, the rest alternating; all: all 1024 corners")
+    ap.add_argument("--no-directions", action="store_true", help="leave out each direction alone at +-3")
     ap.add_argument("--shared", default=os.environ.get("SFLSH_SHARED_DIR", os.path.join(ROOT, "..", "shared")))
     ap.add_argument("--out", default=os.path.join(ROOT, "scripts", "results", "shape_quality.md"))
     a = ap.parse_args()
@@ -64,9 +73,8 @@ def main():
     sections = []
     for model in a.models.split(","):
         if model == "procedural":
-            rows, wall = run_sweep(binary, "procedural", a.random)
-            sections.append(("procedural body (%d shapes: zero, 32 corners, 20 single directions, %d random)"
-                             % (len(rows), a.random), rows, wall))
+            rows, wall = run_sweep(binary, "procedural", a.random, None, a.corners, not a.no_directions)
+            sections.append(("procedural body (%d shapes: %s)" % (len(rows), what(a, a.random)), rows, wall))
         elif model == "makehuman":
             mh = os.path.join(a.shared, "data", "makehuman")
             if not os.path.isdir(mh):
@@ -76,14 +84,24 @@ def main():
                 h5, csv = os.path.join(tmp, "mh.h5"), os.path.join(tmp, "mh_targets.csv")
                 subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "data_tools", "makehuman_to_smpl.py"), mh, h5,
                                 "--target-betas", csv], check=True, stdout=subprocess.DEVNULL)
-                rows, wall = run_sweep(binary, h5, 0, csv)
-            sections.append(("MakeHuman body (%d shapes: zero, 32 corners, 20 single directions, 12 targets)"
-                             % len(rows), rows, wall))
+                rows, wall = run_sweep(binary, h5, 0, csv, a.corners, not a.no_directions)
+            sections.append(("MakeHuman body (%d shapes: %s, 12 targets)" % (len(rows), what(a, 0)), rows, wall))
         else:
             sys.exit("shape_quality_sweep: --models: unknown model '%s' (expected procedural, makehuman)" % model)
         all_ok = write(a.out, sections)  # after every body, so a long run leaves what it measured
     print("shape_quality_sweep: wrote %s (%s)" % (a.out, "all shapes meet the bar" if all_ok else "SOME SHAPES FAIL"))
     return 0 if all_ok else 1
+
+
+def what(a, random):
+    parts = ["zero"]
+    if a.corners != "0":
+        parts.append("%s corners" % ("all 1024" if a.corners == "all" else "32"))
+    if not a.no_directions:
+        parts.append("20 single directions")
+    if random:
+        parts.append("%d random" % random)
+    return ", ".join(parts)
 
 
 def write(path, sections):
@@ -99,14 +117,21 @@ def write(path, sections):
         out += ["## " + title, "",
                 "%d of %d meet the bar; worst min dihedral %.3f deg; time per shape median %.1f s, max %.1f s; "
                 "sweep wall %.0f s." % (good, len(rows), worst, sorted(times)[len(times) // 2], max(times), wall), "",
-                "| shape | min dihedral (deg) | inverted | tets < 8 deg | skin caps removed | time (s) | ok |",
-                "|---|---|---|---|---|---|---|"]
-        out += ["| %s | %s | %s | %s | %s | %s | %s |" % (r[0], r[1], r[2], r[3], r[4], r[5], "yes" if ok(r) else "**no**")
+                "| shape | min dihedral (deg) | inverted | tets < 8 deg | skin caps removed | time (s) "
+                "| skin self-intersects | ok |",
+                "|---|---|---|---|---|---|---|---|"]
+        out += ["| %s | %s | %s | %s | %s | %s | %s | %s |"
+                % (r[0], r[1], r[2], r[3], r[4], r[5], r[6] if len(r) > 6 else "-", "yes" if ok(r) else "**no**")
                 for r in rows]
-        failures = [r for r in rows if r[1] == "failed" and len(r) > 6]
+        invalid = [r for r in rows if not ok(r) and len(r) > 6 and r[6] == "yes"]
+        if invalid:
+            out += ["", "%d of the %d shapes below the bar have a self-intersecting skin: the body model gives "
+                    "no valid solid there, so no tet mesh bounded by it exists (column 'skin self-intersects'; "
+                    "tested only for shapes below the bar)." % (len(invalid), len(rows) - good)]
+        failures = [r for r in rows if r[1] == "failed" and len(r) > 7]
         if failures:
             out += ["", "Why the failed shapes stopped (the shape stage's error):", ""]
-            out += ["- %s: %s" % (r[0], r[6]) for r in failures]
+            out += ["- %s: %s" % (r[0], r[7]) for r in failures]
         out.append("")
         all_ok = all_ok and good == len(rows)
     os.makedirs(os.path.dirname(path), exist_ok=True)

@@ -7,6 +7,7 @@
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 #include "sflsh/mesh/boundary_caps.hpp"
 #include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/volume/body_regions.hpp"
@@ -35,6 +36,8 @@ std::string ShapeReport::describe() const {
     os << "; with skin nodes sliding on the skin: min dihedral " << skin_smoothing.min_dihedral_after << " deg, "
        << skin_smoothing.below_target_after << " tets below target, " << skin_smoothing.nodes_moved
        << " nodes moved (max " << skin_smoothing.max_displacement * 1e3 << " mm)";
+  if (skin_self_intersects == 1)
+    os << "\n  the shaped skin self-intersects (the body model gives no valid solid at these betas)";
   return os.str();
 }
 
@@ -310,9 +313,15 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     for (size_t i = 0; i < kept_tets.size(); ++i) av.tet_region[i] = tv.tet_region[kept_tets[i]];
   }
   out.report.quality = tet_quality_report(av.tet);
-  require(out.report.quality.num_inverted == 0, "shape_volume: ", out.report.quality.num_inverted,
-          " tets inverted for this shape (smallest volume ", out.report.quality.min_volume,
-          " m^3) even with the thickness map relaxed to 1 around them; reduce |betas|");
+  if (out.report.quality.num_inverted > 0 || out.report.quality.min_dihedral_deg < o.quality_floor_deg)
+    out.report.skin_self_intersects = check_surface(v_shaped, F, true).self_intersects ? 1 : 0;
+  require(out.report.quality.num_inverted == 0, "shape_volume: ",
+          out.report.skin_self_intersects == 1
+              ? "the shaped skin self-intersects at these betas (the body model gives no valid solid there, so "
+                "no tet mesh bounded by it exists); "
+              : "",
+          out.report.quality.num_inverted, " tets inverted for this shape (smallest volume ",
+          out.report.quality.min_volume, " m^3) even with the thickness map relaxed to 1 around them; reduce |betas|");
 
   // Meta, skeleton, skin.
   av.betas = betas;

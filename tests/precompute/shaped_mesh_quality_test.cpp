@@ -12,6 +12,8 @@
 
 #include "../test_support.hpp"
 #include "sflsh/body/body_model_io.hpp"
+#include "sflsh/core/error.hpp"
+#include "sflsh/meshing/surface_checks.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/volume/shape_volume.hpp"
 
@@ -76,6 +78,23 @@ TEST(ShapedMeshQuality, MakeHumanHardestTargets) {
   expect_quality(tv, model, "male max weight", betas({3, 0, 0, -3, 0, 3, 0, -3, 0, 0}));
   expect_quality(tv, model, "male min muscle", betas({0, -3, 0, 0, 3, 0, 3, 0, -3, 0}));
   expect_quality(tv, model, "min height", betas({0, 0, -3, 0, 0, 0, 0, 0, 0, 3}));
+
+  // A corner past every target: 0.94 m tall at max weight and muscle. The model's own skin
+  // self-intersects there (CGAL on the shaped surface, independently of the shape stage), so
+  // no mesh bounded by it can be valid; the shape stage must say so rather than only "inverted".
+  const VecX corner = betas({3, 3, -3, 3, 3, -3, 3, -3, 3, -3});
+  ASSERT_TRUE(check_surface(shape_vertices(model, corner), model.faces, true).self_intersects);
+  try {
+    const ShapedVolume s = shape_volume(tv, model, corner, ThicknessMap::defaults());
+    ASSERT_TRUE(s.report.quality.num_inverted == 0 && s.report.quality.min_dihedral_deg < 8.0)
+        << "this corner was expected below the bar on the coarse mesh (min dihedral "
+        << s.report.quality.min_dihedral_deg << ")";
+    EXPECT_EQ(s.report.skin_self_intersects, 1);
+    EXPECT_NE(s.report.describe().find("the shaped skin self-intersects"), std::string::npos);
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the shaped skin self-intersects at these betas"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -82,6 +82,11 @@ struct ShapeReport {
   /// The interior/bone-surface node optimization (quality before/after it),
   /// and the second round with skin nodes sliding (passes = 0 if not run).
   InteriorSmoothingReport smoothing, skin_smoothing;
+  /// Whether the shaped skin (the body model's surface at these betas)
+  /// self-intersects: 1 or 0, tested (CGAL) only when the shaped mesh has an
+  /// inverted tet or one below quality_floor_deg; −1 when not tested. A
+  /// self-intersecting skin bounds no valid solid, so no mesh on it can be good.
+  int skin_self_intersects = -1;
   double seconds = 0;
   std::string describe() const;
 };
