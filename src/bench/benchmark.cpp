@@ -516,6 +516,39 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
                      K);
     }
   }
+  // Scalar skinning eigenmodes (skinning_eigenmodes): weights like the handles' W, 3 DoFs
+  // each; alone at each K's DoF count, and added to the default K's handles.
+  if (wanted("skinning eigenmodes")) {
+    const std::vector<int> added = {K / 4, K / 2, K};
+    int most = added.back();
+    for (const auto& a : avatars) most = std::max(most, a->num_handles());
+    log_info("bench: the " + std::to_string(most) + " lowest skinning eigenmodes (scalar, bones held)");
+    const VibrationModes modes = skinning_eigenmodes(base, most);
+    const VecX mass = simulated_nodal_mass(base);
+    auto trace_of = [&](const MatX& B) {
+      const VectorSubspaceProjector proj(B, mass);
+      std::vector<Points> out;
+      for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
+      return out;
+    };
+    for (const auto& a : avatars) {
+      const int m = a->num_handles();
+      const Eigen::SparseMatrix<double, Eigen::RowMajor> W = modes.phi.leftCols(m).sparseView();
+      add_floor_only(trace_of(vector_basis(W)),
+                     "skinning eigenmodes only, " + std::to_string(m) + " (" + std::to_string(3 * m) +
+                         " DoFs; floor only)",
+                     m);
+    }
+    for (int m : added) {
+      MatX Wb(base.W.rows(), base.W.cols() + m);
+      Wb << MatX(base.W), modes.phi.leftCols(m);
+      const Eigen::SparseMatrix<double, Eigen::RowMajor> W = Wb.sparseView();
+      add_floor_only(trace_of(vector_basis(W)),
+                     "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " skinning eigenmodes (" +
+                         std::to_string(3 * (K + m)) + " DoFs; floor only)",
+                     K);
+    }
+  }
   add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
 }

@@ -79,20 +79,21 @@ class ShiftInvertOperator {
 
 VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, const VecX& mass, int count) {
   const Eigen::Index N = mass.size();
-  require(K.rows() == 3 * N && K.cols() == 3 * N, "vibration modes: stiffness is ", K.rows(), " by ", K.cols(),
-          ", expected ", 3 * N, " by ", 3 * N, " for ", N, " nodal masses");
+  const int d = N > 0 && K.rows() % N == 0 ? int(K.rows() / N) : 0;  // DoFs per node
+  require((d == 1 || d == 3) && K.cols() == K.rows(), "vibration modes: stiffness is ", K.rows(), " by ", K.cols(),
+          ", expected ", N, " or ", 3 * N, " square for ", N, " nodal masses");
   std::vector<int> free;  // DoF indices
   for (Eigen::Index i = 0; i < N; ++i) {
     require(std::isfinite(mass[i]) && mass[i] >= 0, "vibration modes: node ", i, " has mass ", mass[i],
             " (must be finite and >= 0)");
     if (mass[i] > 0)
-      for (int c = 0; c < 3; ++c) free.push_back(int(3 * i + c));
+      for (int c = 0; c < d; ++c) free.push_back(int(d * i + c));
   }
   const int n = int(free.size());
   require(count >= 1 && count < n, "vibration modes: ", count, " modes asked of ", n,
           " free DoFs (must be in [1, free DoFs - 1])");
   // K and M on the free DoFs.
-  std::vector<int> index(size_t(3 * N), -1);
+  std::vector<int> index(size_t(d * N), -1);
   for (int f = 0; f < n; ++f) index[size_t(free[size_t(f)])] = f;
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < K.outerSize(); ++c)
@@ -102,7 +103,7 @@ VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, cons
   Eigen::SparseMatrix<double> Kf(n, n);
   Kf.setFromTriplets(entries.begin(), entries.end());
   VecX mf(n);
-  for (int f = 0; f < n; ++f) mf[f] = mass[free[size_t(f)] / 3];
+  for (int f = 0; f < n; ++f) mf[f] = mass[free[size_t(f)] / d];
 
   ShiftInvertOperator op(Kf, mf);
   const int ncv = std::min(n, std::max(2 * count + 1, count + 20));
@@ -117,7 +118,7 @@ VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, cons
   for (int k = 0; k < count; ++k) order[size_t(k)] = k;
   std::sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
   VibrationModes out;
-  out.phi = MatX::Zero(3 * N, count);
+  out.phi = MatX::Zero(d * N, count);
   out.omega2.resize(count);
   for (int k = 0; k < count; ++k) {
     const int s = order[size_t(k)];
@@ -127,7 +128,10 @@ VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, cons
   return out;
 }
 
-VibrationModes soft_tissue_modes(const Avatar& a, int count) {
+namespace {
+
+/// Lumped mass of the Simulated nodes (density × V / 4 per tet); 0 elsewhere.
+VecX simulated_mass(const Avatar& a) {
   const VecX volume = fem::tet_volumes(a.tet);
   VecX mass = VecX::Zero(a.tet.num_nodes());
   for (int t = 0; t < a.tet.num_elements(); ++t)
@@ -135,11 +139,35 @@ VibrationModes soft_tissue_modes(const Avatar& a, int count) {
       const int i = a.tet.elements(t, c);
       if (a.node_role[i] == int(NodeRole::Simulated)) mass[i] += tet_material(a, t).density * std::abs(volume[t]) / 4;
     }
+  return mass;
+}
+
+}  // namespace
+
+VibrationModes soft_tissue_modes(const Avatar& a, int count) {
   const Eigen::SparseMatrix<double> K = nodal_stiffness(a.tet, [&a](int t, Eigen::Matrix<double, 9, 9>& H) {
     H = linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
     return true;
   });
-  return lowest_vibration_modes(K, mass, count);
+  return lowest_vibration_modes(K, simulated_mass(a), count);
+}
+
+VibrationModes skinning_eigenmodes(const Avatar& a, int count) {
+  // L = Σ_t V_t μ_t G_tᵀ G_t, G_t the 3 by 4 gradient matrix of tet t.
+  const VecX volume = fem::tet_volumes(a.tet);
+  const std::vector<fem::TetGradient> grads = fem::tet_gradients(a.tet);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(size_t(a.tet.num_elements()) * 16);
+  for (int t = 0; t < a.tet.num_elements(); ++t) {
+    const RegionMaterial& m = tet_material(a, t);  // mean of the three Young's moduli, isotropic
+    const double mu = (m.young_along + m.young_through + m.young_around) / 3 / (2 * (1 + m.poisson));
+    const Eigen::Matrix4d Lt = std::abs(volume[t]) * mu * grads[size_t(t)] * grads[size_t(t)].transpose();
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) entries.emplace_back(a.tet.elements(t, r), a.tet.elements(t, c), Lt(r, c));
+  }
+  Eigen::SparseMatrix<double> L(a.tet.num_nodes(), a.tet.num_nodes());
+  L.setFromTriplets(entries.begin(), entries.end());
+  return lowest_vibration_modes(L, simulated_mass(a), count);
 }
 
 }  // namespace sflsh

@@ -56,6 +56,28 @@ TEST(VibrationModes, FixedFreeSpringChainMatchesTheClosedForm) {
   EXPECT_LT((gram - MatX::Identity(9, 9)).lpNorm<Eigen::Infinity>(), 1e-9);
 }
 
+TEST(VibrationModes, ScalarFieldsOneDofPerNode) {
+  // The same chain as a scalar problem (K N by N): each ω² once, in order.
+  const int n = 12;
+  const double k = 250.0, m = 0.4;
+  std::vector<Eigen::Triplet<double>> e;
+  for (int i = 0; i < n; ++i)
+    e.emplace_back(i, i, k), e.emplace_back(i + 1, i + 1, k), e.emplace_back(i, i + 1, -k), e.emplace_back(i + 1, i, -k);
+  Sp K(n + 1, n + 1);
+  K.setFromTriplets(e.begin(), e.end());
+  VecX mass = VecX::Constant(n + 1, m);
+  mass[0] = 0.0;
+  const VibrationModes modes = lowest_vibration_modes(K, mass, 4);
+  ASSERT_EQ(modes.phi.rows(), n + 1);
+  for (int j = 1; j <= 4; ++j) {
+    const double s = std::sin((2 * j - 1) * M_PI / (2.0 * (2 * n + 1)));
+    EXPECT_NEAR(modes.omega2[j - 1], 4 * k / m * s * s, 1e-9 * 4 * k / m * s * s) << j;
+  }
+  EXPECT_EQ(modes.phi(0, 0), 0.0);
+  // A stiffness of neither N nor 3N rows is refused.
+  EXPECT_THROW(lowest_vibration_modes(Sp(2 * (n + 1), 2 * (n + 1)), mass, 2), Error);
+}
+
 TEST(VibrationModes, AgreeWithADenseGeneralizedEigensolver) {
   // A random sparse SPD stiffness with unequal masses and two held nodes.
   const int N = 30;

@@ -19,7 +19,7 @@ namespace sflsh {
 
 /// Modes of a mass-weighted symmetric eigenproblem.
 struct VibrationModes {
-  MatX phi;     ///< 3N by m; row 3i + c is component c at node i; Φᵀ M Φ = I; 0 at fixed nodes
+  MatX phi;     ///< dN by m; row di + c is component c at node i; Φᵀ M Φ = I; 0 at fixed nodes
   VecX omega2;  ///< m eigenvalues ω² (1/s²), ascending
 };
 
@@ -31,7 +31,8 @@ using TetHessian = std::function<bool(int t, Eigen::Matrix<double, 9, 9>& H)>;
 /// Fails naming the tet if one is degenerate or inverted.
 Eigen::SparseMatrix<double> nodal_stiffness(const TetMesh& mesh, const TetHessian& hessian);
 
-/// The `count` lowest modes of K φ = ω² M φ with M = diag(mass ⊗ I₃). Nodes with
+/// The `count` lowest modes of K φ = ω² M φ with M = diag(mass ⊗ I_d), d = 3
+/// (K is 3N by 3N, DoF 3i + c) or d = 1 (K is N by N, scalar fields). Nodes with
 /// mass 0 are fixed (their rows of Φ are 0); K restricted to the others must be
 /// positive definite. Fails (naming the reason) on wrong sizes, a negative or
 /// non-finite mass, count outside [1, free DoFs − 1], a K that its Cholesky factorization
@@ -43,5 +44,12 @@ VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, cons
 /// (linearized_hessian), the lumped mass of the Simulated nodes (density × V / 4
 /// per tet), every node that is not Simulated fixed.
 VibrationModes soft_tissue_modes(const Avatar& avatar, int count);
+
+/// Scalar skinning eigenmodes (in the spirit of Benchekroun et al. 2023, issue 13's third
+/// candidate): the lowest eigenvectors of L w = λ M w, L = Σ_t V_t μ_t G_tᵀ G_t the
+/// shear-modulus-weighted stiffness Laplacian (μ_t from the mean of the tet's three Young's
+/// moduli and its Poisson ratio), M the lumped mass of the Simulated nodes, every other node
+/// held at 0. phi is #N by count: weights for u = W z, 3 DoFs each, like the handles' W.
+VibrationModes skinning_eigenmodes(const Avatar& avatar, int count);
 
 }  // namespace sflsh
