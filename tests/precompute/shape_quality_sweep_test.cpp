@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -124,15 +125,28 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
         std::map<std::string, int> where;
         std::vector<char> outer(tv.tet.num_nodes(), 0);
         for (int i = 0; i < tv.outer_nodes.size(); ++i) outer[tv.outer_nodes[i]] = 1;
+        const Tets& T = s.avatar.tet.elements;
+        std::map<std::array<int, 3>, int> face_uses;
+        auto face = [&](int t, int skip) {
+          std::array<int, 3> f;
+          for (int i = 0, j = 0; i < 4; ++i)
+            if (i != skip) f[size_t(j++)] = T(t, i);
+          std::sort(f.begin(), f.end());
+          return f;
+        };
+        for (int t = 0; t < T.rows(); ++t)
+          for (int k = 0; k < 4; ++k) ++face_uses[face(t, k)];
         for (int t = 0; t < s.avatar.tet.num_elements(); ++t) {
           if (tet_quality(s.avatar.tet, t).min_dihedral_deg >= 8.0) continue;
+          int boundary = 0;
+          for (int k = 0; k < 4; ++k) boundary += face_uses[face(t, k)] == 1;
           int skin = 0, simulated = 0;
           for (int i = 0; i < 4; ++i) {
             skin += outer[s.avatar.tet.elements(t, i)];
             simulated += s.avatar.node_role[s.avatar.tet.elements(t, i)] == int(NodeRole::Simulated);
           }
           ++where[body_region_names()[s.avatar.tet_region[t]] + (simulated ? " simulated" : " dirichlet-only") +
-                  ", " + std::to_string(skin) + " skin nodes"];
+                  ", " + std::to_string(skin) + " skin nodes, " + std::to_string(boundary) + " boundary faces"];
         }
         for (const auto& [k, n] : where) std::printf("    below 8 deg: %d tets in %s\n", n, k.c_str());
       }
