@@ -170,19 +170,6 @@ std::vector<int> simulated_region(const Avatar& a) {
   return out;
 }
 
-/// #N lumped nodal masses (kg) of the Simulated nodes (0 at Dirichlet nodes,
-/// where every displacement is 0): ρ_t V_t / 4 per tet corner.
-VecX simulated_nodal_mass(const Avatar& a) {
-  const VecX vol = fem::tet_volumes(a.tet);
-  VecX m = VecX::Zero(a.tet.num_nodes());
-  for (int t = 0; t < a.tet.num_elements(); ++t)
-    for (int c = 0; c < 4; ++c) {
-      const int i = a.tet.elements(t, c);
-      if (a.node_role[i] == int(NodeRole::Simulated)) m[i] += a.materials[a.tet_region[t]].density * std::abs(vol[t]) / 4;
-    }
-  return m;
-}
-
 /// The skin's soft displacement (#V by 3) interpolated from nodal values
 /// (#N by 3) through (surface_tet, surface_bary), Dirichlet nodes held at 0.
 Points surface_from_nodes(const Avatar& a, const Points& nodal) {
@@ -231,7 +218,7 @@ Trace run_peer(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, d
 /// projection of each reference frame onto span(W ⊗ I₃).
 std::vector<Points> floor_trace(const Avatar& a, const Trace& ref,
                                 const Eigen::SparseMatrix<double, Eigen::RowMajor>* W = nullptr) {
-  const SubspaceProjector proj(W ? *W : a.W, simulated_nodal_mass(a));
+  const SubspaceProjector proj(W ? *W : a.W, simulated_lumped_mass(a));
   std::vector<Points> out;
   for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(a, proj.project(u)));
   return out;
@@ -485,6 +472,13 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
                          std::to_string(12 * a.num_handles()) + " DoFs; floor only)",
                      a.num_handles());
     }
+  // The floor trace of a general vector basis B (3N by D) on the default avatar's mesh.
+  auto vector_floor_trace = [&](const MatX& B) {
+    const VectorSubspaceProjector proj(B, simulated_lumped_mass(base));
+    std::vector<Points> out;
+    for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
+    return out;
+  };
   // The lowest vibration modes of the soft tissue with the bones held (soft_tissue_modes.hpp):
   // alone, as many as each K's handles have DoFs, and added to the default K's handles.
   if (wanted("vibration modes")) {
@@ -493,16 +487,9 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     for (const auto& a : avatars) most = std::max(most, 3 * a->num_handles());
     log_info("bench: the " + std::to_string(most) + " lowest vibration modes of the soft tissue (bones held)");
     const VibrationModes modes = soft_tissue_modes(base, most);
-    const VecX mass = simulated_nodal_mass(base);
-    auto trace_of = [&](const MatX& B) {
-      const VectorSubspaceProjector proj(B, mass);
-      std::vector<Points> out;
-      for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
-      return out;
-    };
     for (const auto& a : avatars) {
       const int m = 3 * a->num_handles();
-      add_floor_only(trace_of(modes.phi.leftCols(m)),
+      add_floor_only(vector_floor_trace(modes.phi.leftCols(m)),
                      "vibration modes only, " + std::to_string(m) + " (" + std::to_string(m) + " DoFs; floor only)",
                      a->num_handles());
     }
@@ -510,7 +497,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     for (int m : added) {
       MatX B(bbw.rows(), bbw.cols() + m);
       B << bbw, modes.phi.leftCols(m);
-      add_floor_only(trace_of(B),
+      add_floor_only(vector_floor_trace(B),
                      "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " vibration modes (" +
                          std::to_string(3 * K + m) + " DoFs; floor only)",
                      K);
@@ -524,17 +511,10 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     for (const auto& a : avatars) most = std::max(most, a->num_handles());
     log_info("bench: the " + std::to_string(most) + " lowest skinning eigenmodes (scalar, bones held)");
     const VibrationModes modes = skinning_eigenmodes(base, most);
-    const VecX mass = simulated_nodal_mass(base);
-    auto trace_of = [&](const MatX& B) {
-      const VectorSubspaceProjector proj(B, mass);
-      std::vector<Points> out;
-      for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
-      return out;
-    };
     for (const auto& a : avatars) {
       const int m = a->num_handles();
       const Eigen::SparseMatrix<double, Eigen::RowMajor> W = modes.phi.leftCols(m).sparseView();
-      add_floor_only(trace_of(vector_basis(W)),
+      add_floor_only(vector_floor_trace(vector_basis(W)),
                      "skinning eigenmodes only, " + std::to_string(m) + " (" + std::to_string(3 * m) +
                          " DoFs; floor only)",
                      m);
@@ -543,7 +523,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
       MatX Wb(base.W.rows(), base.W.cols() + m);
       Wb << MatX(base.W), modes.phi.leftCols(m);
       const Eigen::SparseMatrix<double, Eigen::RowMajor> W = Wb.sparseView();
-      add_floor_only(trace_of(vector_basis(W)),
+      add_floor_only(vector_floor_trace(vector_basis(W)),
                      "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " skinning eigenmodes (" +
                          std::to_string(3 * (K + m)) + " DoFs; floor only)",
                      K);

@@ -128,10 +128,7 @@ VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, cons
   return out;
 }
 
-namespace {
-
-/// Lumped mass of the Simulated nodes (density × V / 4 per tet); 0 elsewhere.
-VecX simulated_mass(const Avatar& a) {
+VecX simulated_lumped_mass(const Avatar& a) {
   const VecX volume = fem::tet_volumes(a.tet);
   VecX mass = VecX::Zero(a.tet.num_nodes());
   for (int t = 0; t < a.tet.num_elements(); ++t)
@@ -142,14 +139,12 @@ VecX simulated_mass(const Avatar& a) {
   return mass;
 }
 
-}  // namespace
-
 VibrationModes soft_tissue_modes(const Avatar& a, int count) {
   const Eigen::SparseMatrix<double> K = nodal_stiffness(a.tet, [&a](int t, Eigen::Matrix<double, 9, 9>& H) {
     H = linearized_hessian(MaterialPoint(tet_material(a, t), tet_frame(a, t)));
     return true;
   });
-  return lowest_vibration_modes(K, simulated_mass(a), count);
+  return lowest_vibration_modes(K, simulated_lumped_mass(a), count);
 }
 
 VibrationModes skinning_eigenmodes(const Avatar& a, int count) {
@@ -167,7 +162,7 @@ VibrationModes skinning_eigenmodes(const Avatar& a, int count) {
   }
   Eigen::SparseMatrix<double> L(a.tet.num_nodes(), a.tet.num_nodes());
   L.setFromTriplets(entries.begin(), entries.end());
-  return lowest_vibration_modes(L, simulated_mass(a), count);
+  return lowest_vibration_modes(L, simulated_lumped_mass(a), count);
 }
 
 }  // namespace sflsh

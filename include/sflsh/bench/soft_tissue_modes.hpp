@@ -40,6 +40,10 @@ Eigen::SparseMatrix<double> nodal_stiffness(const TetMesh& mesh, const TetHessia
 /// run that does not converge.
 VibrationModes lowest_vibration_modes(const Eigen::SparseMatrix<double>& K, const VecX& mass, int count);
 
+/// #N lumped nodal masses (kg) of the Simulated nodes, ρ_t V_t / 4 per tet corner;
+/// 0 at every other node (bone, skinned: their displacement is held at 0).
+VecX simulated_lumped_mass(const Avatar& avatar);
+
 /// The avatar's soft-tissue modes: K of its materials in their frames at rest
 /// (linearized_hessian), the lumped mass of the Simulated nodes (density × V / 4
 /// per tet), every node that is not Simulated fixed.
