@@ -148,21 +148,12 @@ VibrationModes soft_tissue_modes(const Avatar& a, int count) {
 }
 
 VibrationModes skinning_eigenmodes(const Avatar& a, int count) {
-  // L = Σ_t V_t μ_t G_tᵀ G_t, G_t the 3 by 4 gradient matrix of tet t.
-  const VecX volume = fem::tet_volumes(a.tet);
-  const std::vector<fem::TetGradient> grads = fem::tet_gradients(a.tet);
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(size_t(a.tet.num_elements()) * 16);
+  VecX mu(a.tet.num_elements());  // mean of the three Young's moduli, isotropic
   for (int t = 0; t < a.tet.num_elements(); ++t) {
-    const RegionMaterial& m = tet_material(a, t);  // mean of the three Young's moduli, isotropic
-    const double mu = (m.young_along + m.young_through + m.young_around) / 3 / (2 * (1 + m.poisson));
-    const Eigen::Matrix4d Lt = std::abs(volume[t]) * mu * grads[size_t(t)] * grads[size_t(t)].transpose();
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) entries.emplace_back(a.tet.elements(t, r), a.tet.elements(t, c), Lt(r, c));
+    const RegionMaterial& m = tet_material(a, t);
+    mu[t] = (m.young_along + m.young_through + m.young_around) / 3 / (2 * (1 + m.poisson));
   }
-  Eigen::SparseMatrix<double> L(a.tet.num_nodes(), a.tet.num_nodes());
-  L.setFromTriplets(entries.begin(), entries.end());
-  return lowest_vibration_modes(L, simulated_lumped_mass(a), count);
+  return lowest_vibration_modes(fem::stiffness_laplacian(a.tet, mu), simulated_lumped_mass(a), count);
 }
 
 }  // namespace sflsh

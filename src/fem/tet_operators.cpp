@@ -68,8 +68,11 @@ std::vector<std::pair<int, Vec3>> handle_gradients(const TetMesh& mesh, const Te
   return out;
 }
 
-Eigen::SparseMatrix<double> stiffness_laplacian(const TetMesh& mesh) {
-  const VecX vol = tet_volumes(mesh);
+Eigen::SparseMatrix<double> stiffness_laplacian(const TetMesh& mesh, const VecX& tet_weight) {
+  require(tet_weight.size() == 0 || tet_weight.size() == mesh.num_elements(), "stiffness_laplacian: ",
+          tet_weight.size(), " tet weights for ", mesh.num_elements(), " tets");
+  VecX vol = tet_volumes(mesh);
+  if (tet_weight.size() > 0) vol = vol.cwiseProduct(tet_weight);
   const auto grads = tet_gradients(mesh);
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(16 * size_t(mesh.num_elements()));

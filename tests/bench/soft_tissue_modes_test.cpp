@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include "../basis/box_mesh.hpp"
 #include "sflsh/bench/subspace_floor.hpp"
 #include "sflsh/core/error.hpp"
 
@@ -130,15 +131,21 @@ TEST(VibrationModes, BadInputIsRefusedWithAReason) {
   EXPECT_THROW(lowest_vibration_modes(Sp(-K), mass, 2), Error);
 }
 
+/// One tet with the given 4 by 3 nodes.
+TetMesh one_tet(const Points& nodes) {
+  TetMesh mesh;
+  mesh.nodes = nodes;
+  mesh.elements.resize(1, 4);
+  mesh.elements << 0, 1, 2, 3;
+  return mesh;
+}
+
 TEST(NodalStiffness, UniformStrainHasTheLinearElasticEnergy) {
   // One tet; H of Ψ = μ ε:ε + (λ/2) tr²ε over vec(∇u) column-major:
   // H = μ (I + T) + λ v vᵀ (T transposes, v = vec I). For u = A x,
   // ½ uᵀ K u = V (μ ε:ε + λ/2 tr²ε) with ε = (A + Aᵀ)/2; a rotation rate has none.
-  TetMesh mesh;
-  mesh.nodes.resize(4, 3);
-  mesh.nodes << 0.1, 0.0, 0.0, 0.4, 0.05, 0.0, 0.05, 0.3, 0.02, 0.08, 0.1, 0.5;
-  mesh.elements.resize(1, 4);
-  mesh.elements << 0, 1, 2, 3;
+  const TetMesh mesh =
+      one_tet((Points(4, 3) << 0.1, 0.0, 0.0, 0.4, 0.05, 0.0, 0.05, 0.3, 0.02, 0.08, 0.1, 0.5).finished());
   const double mu = 3000, lambda = 27000;
   Eigen::Matrix<double, 9, 9> H = mu * Eigen::Matrix<double, 9, 9>::Identity();
   for (int a = 0; a < 3; ++a)
@@ -171,11 +178,7 @@ TEST(NodalStiffness, UniformStrainHasTheLinearElasticEnergy) {
 
 TEST(NodalStiffness, GradientEntriesFollowTheColumnMajorLayout) {
   // H = e_k e_kᵀ with k = a + 3b (a = 0, b = 1): energy ½ V (∂u_x/∂y)², not (∂u_y/∂x)².
-  TetMesh mesh;
-  mesh.nodes.resize(4, 3);
-  mesh.nodes << 0, 0, 0, 0.2, 0, 0, 0, 0.3, 0, 0, 0, 0.1;
-  mesh.elements.resize(1, 4);
-  mesh.elements << 0, 1, 2, 3;
+  const TetMesh mesh = one_tet((Points(4, 3) << 0, 0, 0, 0.2, 0, 0, 0, 0.3, 0, 0, 0, 0.1).finished());
   const Sp K = nodal_stiffness(mesh, [](int, Eigen::Matrix<double, 9, 9>& H) {
     H.setZero();
     H(0 + 3 * 1, 0 + 3 * 1) = 1.0;
@@ -190,6 +193,28 @@ TEST(NodalStiffness, GradientEntriesFollowTheColumnMajorLayout) {
   }
   EXPECT_NEAR(0.5 * u.dot(K * u), 0.5 * V * 0.05 * 0.05, 1e-15);
   EXPECT_NEAR(0.5 * v.dot(K * v), 0.0, 1e-15);
+}
+
+TEST(SkinningEigenmodes, BarHeldAtOneEndMatchesTheWaveEquation) {
+  // A 1 m bar held at x = 0, free elsewhere: the lowest eigenvalues of
+  // μ Δw = −λ ρ w are λ_j = (μ/ρ) ((2j − 1)π / (2L))², with μ = Ē / (2(1 + ν)) from
+  // the mean Ē of the three Young's moduli: (3 + 1 + 2)·10⁴ / 3 / 2.9 Pa, ρ = 1000.
+  Avatar a;
+  a.tet = test::box_tet_mesh(40, 1, 1, 1.0, 0.05, 0.05);
+  a.tet_region = VecXi::Zero(a.tet.num_elements());
+  RegionMaterial m;
+  m.young_along = 3e4, m.young_through = 1e4, m.young_around = 2e4, m.poisson = 0.45, m.density = 1000;
+  a.materials = {m};
+  a.node_role = VecXi::Constant(a.tet.num_nodes(), int(NodeRole::Simulated));
+  for (int i = 0; i < a.tet.num_nodes(); ++i)
+    if (a.tet.nodes(i, 0) < 1e-9) a.node_role[i] = int(NodeRole::Bone);
+  const VibrationModes modes = skinning_eigenmodes(a, 2);
+  const double c2 = 2e4 / 2.9 / 1000.0;
+  for (int j = 1; j <= 2; ++j) {
+    const double k = (2 * j - 1) * M_PI / 2.0;
+    EXPECT_NEAR(modes.omega2[j - 1], c2 * k * k, 0.01 * c2 * k * k) << j;  // P1 + lumped mass: O(h²)
+  }
+  EXPECT_EQ(modes.phi.rows(), a.tet.num_nodes());
 }
 
 TEST(VectorSubspaceProjector, MatchesADenseWeightedLeastSquaresSolve) {

@@ -15,6 +15,22 @@ TEST(TetOperators, BoxMeshIsPositiveAndFillsTheBox) {
   EXPECT_NEAR(v.sum(), 0.3 * 0.2 * 0.1, 1e-15);
 }
 
+TEST(TetOperators, WeightedLaplacianIntegratesTheWeightedGradient) {
+  // w = 3 on the tets with centroid x < 0.5, 1 elsewhere: for f = a·x,
+  // fᵀLf = Σ_e w_e V_e |a|² = |a|² (3·0.5 + 1·0.5)·0.6·0.5 (each half is whole cubes).
+  const TetMesh m = test::box_tet_mesh(4, 3, 3, 1.0, 0.6, 0.5);
+  VecX w(m.num_elements());
+  for (int e = 0; e < m.num_elements(); ++e) {
+    double cx = 0;
+    for (int c = 0; c < 4; ++c) cx += m.nodes(m.elements(e, c), 0) / 4;
+    w[e] = cx < 0.5 ? 3.0 : 1.0;
+  }
+  const Vec3 a(0.3, -1.2, 2.0);
+  const VecX f = m.nodes * a;
+  EXPECT_NEAR(f.dot(stiffness_laplacian(m, w) * f), a.squaredNorm() * 2.0 * 0.6 * 0.5, 1e-10);
+  EXPECT_THROW(stiffness_laplacian(m, VecX::Ones(3)), Error);
+}
+
 TEST(TetOperators, LaplacianAnnihilatesLinearFieldsAndIsSymmetricPsd) {
   const TetMesh m = test::box_tet_mesh(4, 3, 3, 1.0, 0.6, 0.5);
   const auto L = stiffness_laplacian(m);

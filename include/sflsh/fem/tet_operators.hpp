@@ -32,10 +32,12 @@ std::vector<std::pair<int, Vec3>> handle_gradients(const TetMesh& mesh, const Te
                                                    const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
                                                    const VecXi& node_role, int t);
 
-/// #N by #N stiffness Laplacian L = Σ_e V_e G_eᵀ G_e (m), with G_e the 3 by 4
-/// gradient matrix of tet e. Symmetric PSD; rows sum to zero; L·f = 0 at
-/// interior nodes for every linear f. (Minus the "cotangent Laplacian".)
-Eigen::SparseMatrix<double> stiffness_laplacian(const TetMesh& mesh);
+/// #N by #N stiffness Laplacian L = Σ_e w_e V_e G_eᵀ G_e (m times the unit of w),
+/// with G_e the 3 by 4 gradient matrix of tet e and w_e = `tet_weight`[e] (#T,
+/// e.g. a shear modulus; empty: 1). Symmetric PSD for w ≥ 0; rows sum to zero;
+/// with constant w, L·f = 0 at interior nodes for every linear f. (Minus the
+/// "cotangent Laplacian".) Fails if `tet_weight` is not empty and not #T long.
+Eigen::SparseMatrix<double> stiffness_laplacian(const TetMesh& mesh, const VecX& tet_weight = VecX());
 
 /// #N lumped (barycentric) nodal masses (m^3 for unit density): each tet gives
 /// V_e/4 to each of its nodes. Sums to the mesh volume.
