@@ -479,55 +479,42 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     for (const Points& u : ref.nodal) out.push_back(surface_from_nodes(base, proj.project(u)));
     return out;
   };
-  // The lowest vibration modes of the soft tissue with the bones held (soft_tissue_modes.hpp):
-  // alone, as many as each K's handles have DoFs, and added to the default K's handles.
-  if (wanted("vibration modes")) {
-    const std::vector<int> added = {3 * K / 4, 3 * K / 2, 3 * K};
-    int most = added.back();
-    for (const auto& a : avatars) most = std::max(most, 3 * a->num_handles());
-    log_info("bench: the " + std::to_string(most) + " lowest vibration modes of the soft tissue (bones held)");
-    const VibrationModes modes = soft_tissue_modes(base, most);
+  // Mode bases (soft_tissue_modes.hpp) as a 3N by D vector basis `modes` whose first d
+  // columns are the lowest d / dofs_per_mode modes: alone, as many DoFs as each K's
+  // handles, and added to the default K's handles (3K/4, 3K/2 and 3K more DoFs).
+  const std::vector<int> added_dofs = {3 * K / 4, 3 * K / 2, 3 * K};
+  int most_dofs = added_dofs.back();
+  for (const auto& a : avatars) most_dofs = std::max(most_dofs, 3 * a->num_handles());
+  auto add_mode_floors = [&](const std::string& what, const MatX& modes, int dofs_per_mode) {
     for (const auto& a : avatars) {
-      const int m = 3 * a->num_handles();
-      add_floor_only(vector_floor_trace(modes.phi.leftCols(m)),
-                     "vibration modes only, " + std::to_string(m) + " (" + std::to_string(m) + " DoFs; floor only)",
+      const int d = 3 * a->num_handles();
+      add_floor_only(vector_floor_trace(modes.leftCols(d)),
+                     what + " only, " + std::to_string(d / dofs_per_mode) + " (" + std::to_string(d) +
+                         " DoFs; floor only)",
                      a->num_handles());
     }
     const MatX bbw = vector_basis(base.W);
-    for (int m : added) {
-      MatX B(bbw.rows(), bbw.cols() + m);
-      B << bbw, modes.phi.leftCols(m);
+    for (int d : added_dofs) {
+      d -= d % dofs_per_mode;  // whole modes
+      MatX B(bbw.rows(), bbw.cols() + d);
+      B << bbw, modes.leftCols(d);
       add_floor_only(vector_floor_trace(B),
-                     "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " vibration modes (" +
-                         std::to_string(3 * K + m) + " DoFs; floor only)",
+                     "K=" + std::to_string(K) + " handles + " + std::to_string(d / dofs_per_mode) + " " + what +
+                         " (" + std::to_string(3 * K + d) + " DoFs; floor only)",
                      K);
     }
+  };
+  // The lowest vibration modes of the soft tissue with the bones held: one DoF each.
+  if (wanted("vibration modes")) {
+    log_info("bench: the " + std::to_string(most_dofs) + " lowest vibration modes of the soft tissue (bones held)");
+    add_mode_floors("vibration modes", soft_tissue_modes(base, most_dofs).phi, 1);
   }
-  // Scalar skinning eigenmodes (skinning_eigenmodes): weights like the handles' W, 3 DoFs
-  // each; alone at each K's DoF count, and added to the default K's handles.
+  // Scalar skinning eigenmodes: weights like the handles' W, 3 DoFs each (column 3k + c of
+  // vector_basis is mode k along axis c, so its first 3m columns are the lowest m modes).
   if (wanted("skinning eigenmodes")) {
-    const std::vector<int> added = {K / 4, K / 2, K};
-    int most = added.back();
-    for (const auto& a : avatars) most = std::max(most, a->num_handles());
-    log_info("bench: the " + std::to_string(most) + " lowest skinning eigenmodes (scalar, bones held)");
-    const VibrationModes modes = skinning_eigenmodes(base, most);
-    for (const auto& a : avatars) {
-      const int m = a->num_handles();
-      const Eigen::SparseMatrix<double, Eigen::RowMajor> W = modes.phi.leftCols(m).sparseView();
-      add_floor_only(vector_floor_trace(vector_basis(W)),
-                     "skinning eigenmodes only, " + std::to_string(m) + " (" + std::to_string(3 * m) +
-                         " DoFs; floor only)",
-                     m);
-    }
-    for (int m : added) {
-      MatX Wb(base.W.rows(), base.W.cols() + m);
-      Wb << MatX(base.W), modes.phi.leftCols(m);
-      const Eigen::SparseMatrix<double, Eigen::RowMajor> W = Wb.sparseView();
-      add_floor_only(vector_floor_trace(vector_basis(W)),
-                     "K=" + std::to_string(K) + " handles + " + std::to_string(m) + " skinning eigenmodes (" +
-                         std::to_string(3 * (K + m)) + " DoFs; floor only)",
-                     K);
-    }
+    log_info("bench: the " + std::to_string(most_dofs / 3) + " lowest skinning eigenmodes (scalar, bones held)");
+    const MatX phi = skinning_eigenmodes(base, most_dofs / 3).phi;
+    add_mode_floors("skinning eigenmodes", vector_basis(phi.sparseView()), 3);
   }
   add(run_skinning(base, motion, o.seconds, h), nullptr, "skinning", "skinning only (u = 0)", 0, h, 0, false);
   return rows;
