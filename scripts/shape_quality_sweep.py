@@ -39,14 +39,25 @@ def run_sweep(binary, model, random, betas_csv=None, corners="32", directions=Tr
     if betas_csv:
         env["SFLSH_SWEEP_BETAS"] = betas_csv
     t0 = time.time()
-    p = subprocess.run([binary, "--gtest_also_run_disabled_tests", "--gtest_filter=ShapeQualitySweep.*"],
-                       env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    rows = []
-    for line in p.stdout.splitlines():
-        if line.startswith("SWEEP|"):
+    # Streamed, so a long sweep shows progress (one line per shape on stderr).
+    p = subprocess.Popen([binary, "--gtest_also_run_disabled_tests", "--gtest_filter=ShapeQualitySweep.*"],
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    rows, tail, total = [], [], 0
+    for line in p.stdout:
+        line = line.rstrip("\n")
+        tail = (tail + [line])[-60:]
+        if line.startswith("SWEEP-TOTAL|"):
+            total = int(line.split("|")[1])
+        elif line.startswith("SWEEP|"):
             rows.append(line.split("|")[1:])
+            elapsed = time.time() - t0
+            eta = elapsed / len(rows) * (total - len(rows)) if total else 0
+            print("shape_quality_sweep: %s: %d/%d shapes (%s: %s deg), elapsed %.0f s, ETA %.0f s"
+                  % (os.path.basename(model), len(rows), total, rows[-1][0], rows[-1][1], elapsed, eta),
+                  file=sys.stderr, flush=True)
+    p.wait()
     if not rows:
-        sys.exit("shape_quality_sweep: no result lines from %s for %s:\n%s" % (binary, model, p.stdout[-3000:]))
+        sys.exit("shape_quality_sweep: no result lines from %s for %s:\n%s" % (binary, model, "\n".join(tail)))
     return rows, time.time() - t0
 
 

@@ -103,6 +103,8 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
     }
   }
 
+  std::printf("SWEEP-TOTAL|%zu\n", shapes.size());  // for the driver's progress line
+  std::fflush(stdout);
   double worst = 180, worst_before = 180, total_s = 0;
   std::string worst_name;
   int failed = 0, max_moved = 0;
@@ -116,6 +118,7 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       const int si = s.report.skin_self_intersects;
       std::printf("SWEEP|%s|%.3f|%d|%d|%d|%.2f|%s\n", name.c_str(), q.min_dihedral_deg, q.num_inverted,
                   q.num_below_threshold, s.report.caps_removed, sec, si < 0 ? "-" : si ? "yes" : "no");
+      std::fflush(stdout);
       std::printf("%-24s min dihedral %6.3f deg (before the interior optimization %6.3f), %d below 8, %d inverted, "
                   "%d nodes moved, %d tets below target on fixed nodes only, %d skin nodes slid (max %.2f mm), %.2f s\n",
                   name.c_str(), q.min_dihedral_deg, s.report.smoothing.min_dihedral_before, q.num_below_threshold,
@@ -164,6 +167,7 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       const bool si = why.find("skin self-intersects") != std::string::npos;
       std::printf("SWEEP|%s|failed|-|-|-|%.2f|%s|%s\n", name.c_str(), t.seconds(), si ? "yes" : "-",
                   why.substr(0, 240).c_str());
+      std::fflush(stdout);
       ++failed;
       ADD_FAILURE() << name << ": " << e.what();
     }
