@@ -364,6 +364,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   // Time steps and Newton iterations around the default.
   for (double dt : o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0})
     reduced(default_avatar, K, dt, 1, "dt=1/" + std::to_string(int(std::lround(1.0 / dt))), false);
+  for (int iters : {2, 3}) reduced(default_avatar, K, h, iters, std::to_string(iters) + " Newton iterations", false);
   reduced(default_avatar, K, h, o.converged_newton_iters, "Newton converged", false);
   // Cubature variants: the stratified samples without the stiffness fit, more
   // or fewer candidates, and exact integration (one sample per tet) for the

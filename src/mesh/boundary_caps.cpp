@@ -108,4 +108,75 @@ BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char
   return rep;
 }
 
+BoundaryCapReport remove_bad_boundary_ears(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept_tets, std::vector<int>* kept_nodes) {
+  const int N = mesh.num_nodes(), T = mesh.num_elements();
+  require(int(on_surface.size()) == N, "remove_bad_boundary_ears: ", on_surface.size(), " surface flags for ", N,
+          " nodes");
+  BoundaryCapReport rep;
+  std::vector<char> alive(T, 1), node_alive(N, 1);
+  std::map<Face, int> face_count;  // faces of the alive tets
+  std::vector<int> node_tets(N, 0);
+  for (int t = 0; t < T; ++t)
+    for (int i = 0; i < 4; ++i) {
+      ++face_count[tet_face(mesh.elements, t, i)];
+      ++node_tets[mesh.elements(t, i)];
+    }
+  // The apex of tet t when three of its faces are boundary faces (else −1).
+  auto ear_apex = [&](int t) {
+    int nb = 0, apex = -1;
+    for (int i = 0; i < 4; ++i) {
+      if (face_count[tet_face(mesh.elements, t, i)] == 1)
+        ++nb;
+      else
+        apex = mesh.elements(t, i);  // the face opposite the apex is the only interior one
+    }
+    return nb == 3 ? apex : -1;
+  };
+  auto is_bad = [&](int t) {
+    const TetQuality q = tet_quality(mesh, t);
+    bool all_surface = true;
+    for (int i = 0; i < 4; ++i) all_surface = all_surface && on_surface[mesh.elements(t, i)];
+    return all_surface && (!(q.signed_volume > 0) || q.min_dihedral_deg < floor_deg);
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int t = 0; t < T; ++t) {
+      if (!alive[t] || !is_bad(t)) continue;
+      const int apex = ear_apex(t);
+      if (apex < 0 || node_tets[apex] != 1) continue;
+      alive[t] = 0;
+      node_alive[apex] = 0;
+      ++rep.removed;
+      changed = true;
+      for (int i = 0; i < 4; ++i) {
+        const Face f = tet_face(mesh.elements, t, i);
+        if (--face_count[f] == 0) face_count.erase(f);  // the base stays, now a boundary face
+        --node_tets[mesh.elements(t, i)];
+      }
+    }
+  }
+  std::vector<int> keep, new_index(N, -1), nodes;
+  for (int n = 0; n < N; ++n)
+    if (node_alive[n]) {
+      new_index[n] = int(nodes.size());
+      nodes.push_back(n);
+    }
+  for (int t = 0; t < T; ++t)
+    if (alive[t]) {
+      keep.push_back(t);
+      rep.kept_bad += ear_apex(t) >= 0 && is_bad(t);
+    }
+  Tets e(keep.size(), 4);
+  for (size_t i = 0; i < keep.size(); ++i)
+    for (int c = 0; c < 4; ++c) e(i, c) = new_index[mesh.elements(keep[i], c)];
+  Points x(nodes.size(), 3);
+  for (size_t i = 0; i < nodes.size(); ++i) x.row(i) = mesh.nodes.row(nodes[i]);
+  mesh.elements = e;
+  mesh.nodes = x;
+  if (kept_tets) *kept_tets = keep;
+  if (kept_nodes) *kept_nodes = nodes;
+  return rep;
+}
+
 }  // namespace sflsh

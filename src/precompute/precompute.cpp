@@ -46,8 +46,8 @@ namespace {
 
 // Skin thickness at each node: distance to its skeleton point (handles go
 // where the flesh is thick: belly, buttocks, thighs, ...).
-VecX node_thickness(const TemplateVolume& tv, const Avatar& a) {
-  const Points skeleton = tv.node_skeleton_coefficients * a.joints_rest;
+VecX node_thickness(const TemplateVolume& tv, const VecXi& template_nodes, const Avatar& a) {
+  const Points skeleton = tv.node_skeleton_coefficients(template_nodes, Eigen::all) * a.joints_rest;
   return (a.tet.nodes - skeleton).rowwise().norm();
 }
 
@@ -146,7 +146,7 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   const VecXi node_region = basis::node_regions_from_tets(a.tet, a.tet_region, num_regions);
   basis::HandleSet handles = options.handle_positions.rows() > 0
                                  ? basis::snap_handles(a.tet, a.node_role, options.handle_positions)
-                                 : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, a),
+                                 : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, shaped.template_nodes, a),
                                                          node_region, options.placement);
   a.handles = handles.positions;
   r.handles_s = t.seconds();

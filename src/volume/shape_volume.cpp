@@ -24,6 +24,7 @@ std::string ShapeReport::describe() const {
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
   if (untangled_nodes > 0) os << "; displacement made harmonic at " << untangled_nodes << " folded nodes";
   if (caps_removed > 0) os << "; " << caps_removed << " flattened skin caps removed";
+  if (ears_removed > 0) os << "; " << ears_removed << " flattened skin ears removed with their apex node";
   if (flips.flips_2_3 + flips.flips_3_2 > 0)
     os << "; " << flips.flips_2_3 << " 2-3 and " << flips.flips_3_2 << " 3-2 flips (min dihedral "
        << flips.min_dihedral_before << " -> " << flips.min_dihedral_after << " deg)";
@@ -306,6 +307,21 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       remove_caps();
     }
   }
+  // Ears still below the floor (a skin node in a single tet, its three faces
+  // on the skin, flattened where the shape flattens the skin under it): no
+  // move along the skin raises them, so they go with their apex node.
+  VecXi& tn = out.template_nodes;
+  tn = VecXi::LinSpaced(N, 0, N - 1);
+  if (o.remove_bad_caps && o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+    std::vector<int> kept, nodes;
+    out.report.ears_removed = remove_bad_boundary_ears(av.tet, on_skin, quality_floor, &kept, &nodes).removed;
+    if (out.report.ears_removed > 0) {
+      if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
+      for (int& t : kept) t = kept_tets[t];
+      kept_tets = kept;
+      tn = Eigen::Map<const VecXi>(nodes.data(), Eigen::Index(nodes.size()));
+    }
+  }
   if (kept_tets.empty()) {
     av.tet_region = tv.tet_region;
   } else {
@@ -340,14 +356,25 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   out.report.max_embedding_distance = emb.distance.maxCoeff();
   out.report.num_embedded_outside = emb.num_outside;
 
-  // Volume fields.
-  av.node_weights = tv.node_weights;
-  av.node_role = tv.node_role;
-  av.surface_nodes = tv.outer_nodes;
+  // Volume fields: the template's per-node fields at the avatar's nodes.
+  const int N_av = int(tn.size());
+  VecXi new_index = VecXi::Constant(N, -1);
+  for (int i = 0; i < N_av; ++i) new_index[tn[i]] = i;
+  std::vector<int> outer;
+  for (int i = 0; i < tv.outer_nodes.size(); ++i)
+    if (new_index[tv.outer_nodes[i]] >= 0) outer.push_back(new_index[tv.outer_nodes[i]]);
+  const VecXi outer_nodes = Eigen::Map<const VecXi>(outer.data(), Eigen::Index(outer.size()));
+  const Points sb_av = sb(tn, Eigen::all);
+  const VecXi node_segment = tv.node_segment(tn);
+  av.node_weights = tv.node_weights(tn, Eigen::all);
+  av.node_role = tv.node_role(tn);
+  av.surface_nodes = outer_nodes;
+  out.node_depth = VecX(out.node_depth(tn));
+  out.node_thickness_scale = VecX(out.node_thickness_scale(tn));
   av.materials = default_region_materials();
-  av.tet_frames = tet_frames(av.tet, sb, tv.node_segment, tv.segments, model.parents, joints);
-  av.capsules = fit_bone_capsules(av.tet.nodes, sb, tv.outer_nodes, tv.node_segment, tv.segments,
-                                  model.parents, joints, o.capsule_percentile);
+  av.tet_frames = tet_frames(av.tet, sb_av, node_segment, tv.segments, model.parents, joints);
+  av.capsules = fit_bone_capsules(av.tet.nodes, sb_av, outer_nodes, node_segment, tv.segments, model.parents, joints,
+                                  o.capsule_percentile);
   out.report.seconds = timer.seconds();
   return out;
 }

@@ -65,5 +65,75 @@ TEST(BoundaryCaps, KeepsGoodCapsCapsOffTheSurfaceAndLoneTets) {
   EXPECT_THROW(remove_bad_boundary_caps(lone, std::vector<char>(4, 1), 8.0), Error);
 }
 
+// Two tets (a, c, d, e), (b, c, d, e) sharing face (c, d, e), and an ear (a, c, d, p) on the
+// boundary face (a, c, d): p at height s over the face's centroid, on its outer side (normal
+// (−1, −1, 1)/√3 by hand, e below it), so the ear's volume is s·|face|/3 and it is flat for
+// small s. p is node 2, so the nodes after it move down by one. (b, c, d, e) is an ear too,
+// around b, but a good one.
+TetMesh mesh_with_ear(double s) {
+  TetMesh m;
+  const Vec3 a(0, 0, 0), c(1, 0, 1), d(0, 1, 1), n = Vec3(-1, -1, 1).normalized();
+  const Vec3 p = (a + c + d) / 3 + s * n;
+  m.nodes.resize(6, 3);
+  m.nodes << a.transpose(), c.transpose(), p.transpose(), d.transpose(), 0.5, 0.5, -1, 1, 1, 0;
+  m.elements.resize(3, 4);
+  m.elements << 0, 1, 3, 4,  // a c d e
+      5, 1, 3, 4,            // b c d e
+      0, 1, 3, 2;            // a c d p: the ear
+  orient_tets_positively(m);
+  return m;
+}
+
+TEST(BoundaryEars, RemovesAFlatEarWithItsApexAndRenumbersTheNodes) {
+  TetMesh m = mesh_with_ear(0.01);
+  const double face_area = 0.5 * Vec3(1, 0, 1).cross(Vec3(0, 1, 1)).norm();  // √3/2
+  EXPECT_NEAR(std::abs(tet_quality(m, 2).signed_volume), 0.01 * face_area / 3, 1e-12);
+  ASSERT_LT(tet_quality(m, 2).min_dihedral_deg, 8.0);
+  ASSERT_GT(tet_quality(m, 1).min_dihedral_deg, 8.0);
+  const TetMesh before = m;
+  std::vector<int> kept_tets, kept_nodes;
+  const BoundaryCapReport r = remove_bad_boundary_ears(m, std::vector<char>(6, 1), 8.0, &kept_tets, &kept_nodes);
+  EXPECT_EQ(r.removed, 1);
+  EXPECT_EQ(r.kept_bad, 0);
+  EXPECT_EQ(kept_tets, (std::vector<int>{0, 1}));
+  EXPECT_EQ(kept_nodes, (std::vector<int>{0, 1, 3, 4, 5}));
+  ASSERT_EQ(m.num_nodes(), 5);
+  ASSERT_EQ(m.num_elements(), 2);
+  // Same tets, same points: every corner of the output is the input's corner moved to its new index.
+  for (int t = 0; t < 2; ++t)
+    for (int k = 0; k < 4; ++k)
+      EXPECT_EQ(m.nodes.row(m.elements(t, k)), before.nodes.row(before.elements(t, k))) << t << " " << k;
+  EXPECT_EQ(m.elements.maxCoeff(), 4);
+  EXPECT_EQ(tet_quality_report(m).num_inverted, 0);
+}
+
+TEST(BoundaryEars, KeepsGoodEarsEarsOffTheSurfaceAndPinchedApexes) {
+  TetMesh good = mesh_with_ear(0.5);
+  ASSERT_GT(tet_quality(good, 2).min_dihedral_deg, 8.0);
+  EXPECT_EQ(remove_bad_boundary_ears(good, std::vector<char>(6, 1), 8.0).removed, 0);
+  EXPECT_EQ(good.num_nodes(), 6);
+
+  TetMesh off = mesh_with_ear(0.01);
+  std::vector<char> surface(6, 1);
+  surface[2] = 0;  // the apex is not on the surface
+  EXPECT_EQ(remove_bad_boundary_ears(off, surface, 8.0).removed, 0);
+
+  // The apex also in a tet of its own above it (a pinched vertex): it cannot go, so neither can the ear.
+  TetMesh pinched = mesh_with_ear(0.01);
+  const Vec3 p = pinched.nodes.row(2).transpose();
+  pinched.nodes.conservativeResize(9, 3);
+  pinched.nodes.row(6) = (p + Vec3(1, 0, 2)).transpose();
+  pinched.nodes.row(7) = (p + Vec3(0, 1, 2)).transpose();
+  pinched.nodes.row(8) = (p + Vec3(0, 0, 3)).transpose();
+  pinched.elements.conservativeResize(4, 4);
+  pinched.elements.row(3) << 2, 6, 7, 8;
+  orient_tets_positively(pinched);
+  const BoundaryCapReport r = remove_bad_boundary_ears(pinched, std::vector<char>(9, 1), 8.0);
+  EXPECT_EQ(r.removed, 0);
+  EXPECT_EQ(r.kept_bad, 1);
+  EXPECT_EQ(pinched.num_nodes(), 9);
+  EXPECT_THROW(remove_bad_boundary_ears(pinched, std::vector<char>(3, 1), 8.0), Error);
+}
+
 }  // namespace
 }  // namespace sflsh

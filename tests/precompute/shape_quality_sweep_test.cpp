@@ -137,8 +137,9 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
           std::sort(f.begin(), f.end());
           return f;
         };
+        std::vector<int> node_tets(size_t(s.avatar.tet.num_nodes()), 0);
         for (int t = 0; t < T.rows(); ++t)
-          for (int k = 0; k < 4; ++k) ++face_uses[face(t, k)];
+          for (int k = 0; k < 4; ++k) ++face_uses[face(t, k)], ++node_tets[size_t(T(t, k))];
         for (int t = 0; t < s.avatar.tet.num_elements(); ++t) {
           if (tet_quality(s.avatar.tet, t).min_dihedral_deg >= 8.0) continue;
           int boundary = 0;
@@ -148,8 +149,13 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
             skin += outer[s.avatar.tet.elements(t, i)];
             simulated += s.avatar.node_role[s.avatar.tet.elements(t, i)] == int(NodeRole::Simulated);
           }
+          std::string apex;  // an ear's apex: the node its three boundary faces share
+          if (boundary == 3)
+            for (int k = 0; k < 4; ++k)
+              if (face_uses[face(t, k)] != 1)
+                apex = " (apex node in " + std::to_string(node_tets[size_t(T(t, k))]) + " tets)";
           ++where[body_region_names()[s.avatar.tet_region[t]] + (simulated ? " simulated" : " dirichlet-only") +
-                  ", " + std::to_string(skin) + " skin nodes, " + std::to_string(boundary) + " boundary faces"];
+                  ", " + std::to_string(skin) + " skin nodes, " + std::to_string(boundary) + " boundary faces" + apex];
         }
         for (const auto& [k, n] : where) std::printf("    below 8 deg: %d tets in %s\n", n, k.c_str());
       }

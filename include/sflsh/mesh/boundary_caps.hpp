@@ -15,7 +15,7 @@
 namespace sflsh {
 
 struct BoundaryCapReport {
-  int removed = 0;  ///< tets removed
+  int removed = 0;  ///< tets removed (remove_bad_boundary_ears: also the apex nodes removed)
   /// Caps still below the floor or inverted that could not be removed
   /// (removal would make an edge or a node non-manifold or orphan a node).
   int kept_bad = 0;
@@ -32,5 +32,23 @@ struct BoundaryCapReport {
 /// moved or renumbered. Deterministic (lowest tet index first).
 BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
                                            std::vector<int>* kept = nullptr);
+
+/// Removes, repeatedly until none is left, every *ear* of `mesh` below the
+/// floor: a tet three of whose faces are boundary faces around an apex node
+/// that is in no other tet, whose four nodes have `on_surface[n] != 0`, and
+/// whose smallest dihedral angle is below `floor_deg` (deg) or whose signed
+/// volume is <= 0. No node move that keeps the nodes on the surface raises
+/// such a tet when the surface flattens under it; removing it makes its
+/// fourth face boundary (the base's edges stay in exactly two boundary faces,
+/// so the boundary stays 2-manifold) and drops the apex node, which is then in
+/// no tet. The remaining nodes keep their order: `kept_nodes` (#N' indices
+/// into the input's nodes) and `kept_tets` (#T' indices into the input's
+/// tets) receive the survivors, so per-node and per-tet fields can follow.
+/// `removed` counts tets (= nodes) removed; `kept_bad` ears below the floor
+/// that stay (their apex is in other tets too, e.g. at a pinched vertex).
+/// Deterministic (lowest tet index first).
+BoundaryCapReport remove_bad_boundary_ears(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept_tets = nullptr,
+                                           std::vector<int>* kept_nodes = nullptr);
 
 }  // namespace sflsh

@@ -77,6 +77,9 @@ struct ShapeReport {
   int untangled_nodes = 0;
   /// Skin cap tets removed (the avatar has that many fewer tets than the template).
   int caps_removed = 0;
+  /// Skin ears removed with their apex node (the avatar has that many fewer
+  /// tets and nodes than the template; mesh/boundary_caps.hpp).
+  int ears_removed = 0;
   /// Flips made after the node moves (the tet count changes by one per flip).
   TetFlipReport flips;
   /// The interior/bone-surface node optimization (quality before/after it),
@@ -99,6 +102,9 @@ struct ShapedVolume {
   Avatar avatar;
   VecX node_depth;       ///< #N depth fraction after the thickness map
   VecX node_thickness_scale;  ///< #N smoothed thickness scale applied
+  /// #N template node of each avatar node (the identity unless ears were
+  /// removed, ShapeReport::ears_removed): per-node template fields follow it.
+  VecXi template_nodes;
   ShapeReport report;
 };
 
