@@ -4,6 +4,7 @@
 #include <array>
 #include <map>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
@@ -51,22 +52,25 @@ bool same_volume(const Points& x, const std::vector<Tet>& fresh, const std::vect
   return b > 0 && std::abs(a - b) <= 1e-9 * b;
 }
 
-}  // namespace
-
-TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
-  TetFlipReport rep;
-  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
-  std::vector<Tet> tets(mesh.num_elements());
-  std::vector<int> origin(mesh.num_elements());
-  std::vector<char> alive(tets.size(), 1);
-  for (int t = 0; t < mesh.num_elements(); ++t) {
-    for (int i = 0; i < 4; ++i) tets[t][i] = mesh.elements(t, i);
-    origin[t] = t;
-  }
+// The tets being flipped, with the face and edge adjacency kept up to date;
+// new tets are appended, replaced ones marked dead.
+struct FlipMesh {
+  std::vector<Tet> tets;
+  std::vector<int> origin;  // input tet each tet descends from
+  std::vector<char> alive;
   std::map<Face, std::vector<int>> face_tets;
   std::map<std::pair<int, int>, std::vector<int>> edge_tets;
-  auto edge = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
-  auto link = [&](int t, bool add) {
+
+  static std::pair<int, int> edge(int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); }
+
+  explicit FlipMesh(const TetMesh& mesh) : tets(mesh.num_elements()), origin(mesh.num_elements()), alive(tets.size(), 1) {
+    for (int t = 0; t < mesh.num_elements(); ++t) {
+      for (int i = 0; i < 4; ++i) tets[t][i] = mesh.elements(t, i);
+      origin[t] = t;
+    }
+    for (size_t t = 0; t < tets.size(); ++t) link(int(t), true);
+  }
+  void link(int t, bool add) {
     const Tet& v = tets[t];
     for (int i = 0; i < 4; ++i) {
       auto& f = face_tets[key(v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4])];
@@ -76,11 +80,8 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
         if (add) e.push_back(t); else e.erase(std::find(e.begin(), e.end(), t));
       }
     }
-  };
-  for (size_t t = 0; t < tets.size(); ++t) link(int(t), true);
-  const Points& x = mesh.nodes;
-  auto rate = [&](int t) { return quality(x, tets[t]).min_dihedral_deg; };
-  auto replace = [&](const std::vector<int>& old, const std::vector<Tet>& fresh) {
+  }
+  void replace(const std::vector<int>& old, const std::vector<Tet>& fresh) {
     for (int t : old) link(t, false), alive[t] = 0;
     for (const Tet& n : fresh) {
       tets.push_back(n);
@@ -88,13 +89,39 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
       origin.push_back(origin[old[0]]);
       link(int(tets.size()) - 1, true);
     }
-  };
+  }
+  /// Writes the live tets back to `mesh` (and their origins to `parent`).
+  void finish(TetMesh& mesh, std::vector<int>* parent) const {
+    std::vector<int> keep;
+    for (size_t t = 0; t < tets.size(); ++t)
+      if (alive[t]) keep.push_back(int(t));
+    mesh.elements.resize(keep.size(), 4);
+    if (parent) parent->resize(keep.size());
+    for (size_t i = 0; i < keep.size(); ++i) {
+      for (int k = 0; k < 4; ++k) mesh.elements(i, k) = tets[keep[i]][k];
+      if (parent) (*parent)[i] = origin[keep[i]];
+    }
+  }
+};
+
+}  // namespace
+
+TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
+  TetFlipReport rep;
+  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
+  FlipMesh m(mesh);
+  std::vector<Tet>& tets = m.tets;
+  auto& face_tets = m.face_tets;
+  auto& edge_tets = m.edge_tets;
+  const auto edge = FlipMesh::edge;
+  const Points& x = mesh.nodes;
+  auto rate = [&](int t) { return quality(x, tets[t]).min_dihedral_deg; };
 
   for (int round = 0; round < rounds; ++round) {
     int made = 0;
     const size_t count = tets.size();
     for (size_t t = 0; t < count; ++t) {
-      if (!alive[t] || rate(int(t)) >= target_deg) continue;
+      if (!m.alive[t] || rate(int(t)) >= target_deg) continue;
       bool done = false;
       // 2-3 across each interior face.
       for (int i = 0; i < 4 && !done; ++i) {
@@ -111,7 +138,7 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
         std::vector<Tet> fresh = {{f[0], f[1], a, e}, {f[1], f[2], a, e}, {f[2], f[0], a, e}};
         const double before = std::min(rate(int(t)), rate(u));
         if (orient_and_rate(x, fresh) > before + 1e-9 && same_volume(x, fresh, {tets[t], tets[u]})) {
-          replace({int(t), u}, fresh);
+          m.replace({int(t), u}, fresh);
           ++rep.flips_2_3;
           done = true;
         }
@@ -150,7 +177,7 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
           const double sa = nrm.dot(x.row(a).transpose() - p0), sb = nrm.dot(x.row(b).transpose() - p0);
           if (valid && sa * sb < 0 && worst > before + 1e-9 &&
               same_volume(x, fresh, {tets[ring[0]], tets[ring[1]], tets[ring[2]]})) {
-            replace(ring, fresh);
+            m.replace(ring, fresh);
             ++rep.flips_3_2;
             done = true;
           }
@@ -159,15 +186,72 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
     }
     if (made == 0) break;
   }
-  std::vector<int> keep;
-  for (size_t t = 0; t < tets.size(); ++t)
-    if (alive[t]) keep.push_back(int(t));
-  mesh.elements.resize(keep.size(), 4);
-  if (parent) parent->resize(keep.size());
-  for (size_t i = 0; i < keep.size(); ++i) {
-    for (int k = 0; k < 4; ++k) mesh.elements(i, k) = tets[keep[i]][k];
-    if (parent) (*parent)[i] = origin[keep[i]];
+  m.finish(mesh, parent);
+  rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
+  return rep;
+}
+
+TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on_surface, double target_deg,
+                                      int rounds, std::vector<int>* parent) {
+  require(int(on_surface.size()) == mesh.num_nodes(), "flip_bad_boundary_edges: ", on_surface.size(),
+          " surface flags for ", mesh.num_nodes(), " nodes");
+  TetFlipReport rep;
+  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
+  FlipMesh m(mesh);
+  const Points& x = mesh.nodes;
+  auto rate = [&](int t) { return quality(x, m.tets[t]).min_dihedral_deg; };
+  auto point = [&](int n) -> Vec3 { return x.row(n).transpose(); };
+  for (int round = 0; round < rounds; ++round) {
+    int made = 0;
+    const size_t count = m.tets.size();
+    for (size_t t = 0; t < count; ++t) {
+      if (!m.alive[t] || rate(int(t)) >= target_deg) continue;
+      bool done = false;
+      for (int i = 0; i < 4 && !done; ++i)
+        for (int j = i + 1; j < 4 && !done; ++j) {
+          const int q = m.tets[t][i], r = m.tets[t][j];
+          const std::vector<int> fan = m.edge_tets[FlipMesh::edge(q, r)];
+          if (fan.size() != 2 || !on_surface[q] || !on_surface[r]) continue;
+          // The fan's two tets share the face (q, r, i); a and b are their other nodes.
+          int node_a = -1, node_b = -1, inner = -1;
+          for (int k = 0; k < 4; ++k) {
+            const int v = m.tets[fan[0]][k];
+            if (v == q || v == r) continue;
+            if (std::find(m.tets[fan[1]].begin(), m.tets[fan[1]].end(), v) != m.tets[fan[1]].end())
+              inner = v;
+            else
+              node_a = v;
+          }
+          for (int k = 0; k < 4; ++k) {
+            const int v = m.tets[fan[1]][k];
+            if (v != q && v != r && v != inner) node_b = v;
+          }
+          if (inner < 0 || node_a < 0 || node_b < 0 || !on_surface[node_a] || !on_surface[node_b]) continue;
+          // Both outer faces on the boundary, the shared one inside, and a–b not an edge yet.
+          if (m.face_tets[key(node_a, q, r)].size() != 1 || m.face_tets[key(node_b, q, r)].size() != 1 ||
+              m.face_tets[key(inner, q, r)].size() != 2 || !m.edge_tets[FlipMesh::edge(node_a, node_b)].empty())
+            continue;
+          const Vec3 pa = point(node_a), n = (point(node_b) - pa).cross(point(inner) - pa);
+          if (n.dot(point(q) - pa) * n.dot(point(r) - pa) >= 0) continue;  // q, r on one side: not a flip
+          std::vector<Tet> fresh = {{node_a, node_b, q, inner}, {node_a, node_b, r, inner}};
+          double worst = 180;
+          bool valid = true;
+          for (Tet& nt : fresh) {  // each on its own: they lie on opposite sides of (a, b, i)
+            const double v = quality(x, nt).signed_volume;
+            if (v == 0) valid = false;
+            if (v < 0) std::swap(nt[2], nt[3]);
+            worst = std::min(worst, quality(x, nt).min_dihedral_deg);
+          }
+          if (!valid || worst <= std::min(rate(fan[0]), rate(fan[1])) + 1e-9) continue;
+          m.replace(fan, fresh);
+          ++rep.flips_2_2;
+          done = true;
+        }
+      made += done;
+    }
+    if (made == 0) break;
   }
+  m.finish(mesh, parent);
   rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
   return rep;
 }

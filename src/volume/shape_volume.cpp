@@ -24,6 +24,7 @@ std::string ShapeReport::describe() const {
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
   if (untangled_nodes > 0) os << "; displacement made harmonic at " << untangled_nodes << " folded nodes";
   if (caps_removed > 0) os << "; " << caps_removed << " flattened skin caps removed";
+  if (flips.flips_2_2 > 0) os << "; " << flips.flips_2_2 << " skin edges flipped (boundary 2-2)";
   if (ears_removed > 0) os << "; " << ears_removed << " flattened skin ears removed with their apex node";
   if (flips.flips_2_3 + flips.flips_3_2 > 0)
     os << "; " << flips.flips_2_3 << " 2-3 and " << flips.flips_3_2 << " 3-2 flips (min dihedral "
@@ -292,7 +293,8 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
       for (int& t : parent) t = kept_tets[t];
       kept_tets = parent;
-      if (out.report.flips.min_dihedral_after < quality_floor) {
+      // Skin nodes of the tets still below the floor may slide further.
+      auto slide_skin_of_bad_tets = [&] {
         for (int t = 0; t < av.tet.num_elements(); ++t)
           if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
             for (int i = 0; i < 4; ++i)
@@ -303,6 +305,19 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
         InteriorSmoothingOptions wide = so;
         wide.max_displacement_fraction = o.final_skin_slide_fraction;
         smooth_interior_nodes(av.tet, freedom, normals, wide, [&](const Vec3& y) { return skin.closest_point(y); });
+      };
+      if (out.report.flips.min_dihedral_after < quality_floor) slide_skin_of_bad_tets();
+      // Tets below the floor whose skin face is itself a needle or a flat
+      // triangle (no fourth-node position helps): the skin edge they share
+      // is flipped (boundary 2-2 flip; the skin nodes stay, the skin is
+      // retriangulated on them), then the nodes move once more.
+      if (tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+        out.report.flips.flips_2_2 =
+            flip_bad_boundary_edges(av.tet, on_skin, quality_floor, o.flip_rounds, &parent).flips_2_2;
+        for (int& t : parent) t = kept_tets[t];
+        kept_tets = parent;
+        if (out.report.flips.flips_2_2 > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor)
+          slide_skin_of_bad_tets();
       }
       remove_caps();
     }

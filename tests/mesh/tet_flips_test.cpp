@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 
@@ -77,6 +78,63 @@ TEST(TetFlips, ThreeTwoFlipRemovesALongEdge) {
   ASSERT_EQ(m.num_elements(), 2);
   EXPECT_NEAR(volume(m), 0.5 / 3 * 2, 1e-12);
   EXPECT_NEAR(r.min_dihedral_after, tet_quality_report(two).min_dihedral_deg, 1e-9);
+}
+
+// A kite on the surface z = 0 with perpendicular diagonals q–r (x axis, length 2) and a–b
+// (y axis, length 1.05), crossing at the origin, over an inner node i at depth 1: the tets
+// (a, q, r, i), (b, q, r, i). a sits 5 cm off q–r, so the surface triangle (a, q, r) is a
+// needle (angles ~3, 3, 174 deg) and no position of i could raise its tet.
+TetMesh needle_on_the_surface() {
+  TetMesh m;
+  m.nodes.resize(5, 3);
+  m.nodes << 0, 0.05, 0,  // a
+      0, -1, 0,           // b
+      -1, 0, 0,           // q
+      1, 0, 0,            // r
+      0, -0.3, -1;        // i
+  m.elements.resize(2, 4);
+  m.elements << 0, 2, 3, 4, 1, 2, 3, 4;
+  orient_tets_positively(m);
+  return m;
+}
+
+TEST(TetFlips, BoundaryTwoTwoFlipReplacesANeedleSurfaceTriangle) {
+  TetMesh m = needle_on_the_surface();
+  const double before = tet_quality_report(m).min_dihedral_deg;
+  ASSERT_LT(before, 8.0);
+  std::vector<int> parent;
+  const TetFlipReport r = flip_bad_boundary_edges(m, std::vector<char>(5, 1), 8.0, 4, &parent);
+  EXPECT_EQ(r.flips_2_2, 1);
+  EXPECT_EQ(r.flips_2_3 + r.flips_3_2, 0);
+  ASSERT_EQ(m.num_elements(), 2);
+  EXPECT_EQ(parent, (std::vector<int>{0, 0}));
+  for (int t = 0; t < 2; ++t) {  // both new tets hold the new edge a-b and the inner node
+    std::set<int> v(m.elements.row(t).data(), m.elements.row(t).data() + 4);
+    EXPECT_TRUE(v.count(0) && v.count(1) && v.count(4)) << t;
+    EXPECT_GT(tet_quality(m, t).signed_volume, 0.0);
+  }
+  // Coplanar surface nodes: the same pyramid, area 2 * 1.05 / 2 over height 1, volume 0.35.
+  EXPECT_NEAR(volume(m), 0.35, 1e-12);
+  EXPECT_GT(r.min_dihedral_after, 20.0);
+  EXPECT_NEAR(r.min_dihedral_before, before, 1e-12);
+}
+
+TEST(TetFlips, BoundaryTwoTwoFlipNeedsSurfaceNodesAndAConvexQuad) {
+  TetMesh m = needle_on_the_surface();
+  std::vector<char> surface(5, 1);
+  surface[1] = 0;  // b off the surface
+  EXPECT_EQ(flip_bad_boundary_edges(m, surface, 8.0).flips_2_2, 0);
+  // a moved past r along x (still a needle, now beyond r): a-b crosses the x axis at x = 1.43,
+  // outside q-r, so the quad a, q, b, r is not convex; q and r lie on one side of the plane
+  // (a, b, i) (signed distances -2.55 and -0.45 times |n|, by hand) and the new tets would overlap.
+  TetMesh bent = needle_on_the_surface();
+  bent.nodes.row(0) << 1.5, 0.05, 0;
+  orient_tets_positively(bent);
+  ASSERT_LT(tet_quality_report(bent).min_dihedral_deg, 8.0);
+  const Tets old = bent.elements;
+  EXPECT_EQ(flip_bad_boundary_edges(bent, std::vector<char>(5, 1), 8.0).flips_2_2, 0);
+  EXPECT_EQ(bent.elements, old);
+  EXPECT_THROW(flip_bad_boundary_edges(m, std::vector<char>(4, 1), 8.0), Error);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@ namespace sflsh {
 
 struct TetFlipReport {
   int flips_2_3 = 0, flips_3_2 = 0;
+  int flips_2_2 = 0;  ///< boundary 2-2 flips (flip_bad_boundary_edges)
   double min_dihedral_before = 0, min_dihedral_after = 0;  ///< deg, over the whole mesh
 };
 
@@ -28,5 +29,21 @@ struct TetFlipReport {
 /// input tet it replaces (itself if untouched), so per-tet fields can follow.
 /// Deterministic.
 TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds = 4, std::vector<int>* parent = nullptr);
+
+/// The boundary 2-2 flip, for a bad tet whose boundary face is itself a
+/// needle or a flat triangle on the surface (no fourth-node position helps
+/// then): two tets (a, q, r, i), (b, q, r, i) that are the only tets around
+/// the boundary edge (q, r), with boundary faces (a, q, r), (b, q, r), become
+/// (a, b, q, i), (a, b, r, i): the surface edge q–r gives way to a–b, the
+/// surface is retriangulated on the same four surface nodes (`on_surface`,
+/// #N flags) and no node moves. Made, for every tet below `target_deg` (deg),
+/// only if a–b is not an edge yet, q and r lie on opposite sides of the plane
+/// (a, b, i), both new tets are positively oriented and their smallest
+/// dihedral angle exceeds that of the two they replace. Repeats up to
+/// `rounds` sweeps. The enclosed volume changes by the sliver (a, b, q, r)
+/// between the two triangulations of the surface quad. `parent` as above.
+/// Counts go to flips_2_2. Deterministic.
+TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on_surface, double target_deg,
+                                      int rounds = 4, std::vector<int>* parent = nullptr);
 
 }  // namespace sflsh
