@@ -98,9 +98,10 @@ double reset_peak_rss_mib() {
 
 Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
                   int newton_iters, const std::string& label, bool bones_dynamic = false,
-                  bool mean_dilatation = SimulatorOptions().mean_dilatation) {
+                  bool mean_dilatation = SimulatorOptions().mean_dilatation, double nonlinearity_tolerance = 0.0) {
   const double rss0 = reset_peak_rss_mib();
   SimulatorOptions o;
+  o.newton.nonlinearity_tolerance = nonlinearity_tolerance;
   o.mean_dilatation = mean_dilatation;
   o.h = h;
   o.bones_dynamic = bones_dynamic;
@@ -339,10 +340,12 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     return false;
   };
   auto reduced = [&](std::shared_ptr<const Avatar> a, int K, double dt, int iters, const std::string& what,
-                     bool is_default, bool mean_dilatation = SimulatorOptions().mean_dilatation) {
+                     bool is_default, bool mean_dilatation = SimulatorOptions().mean_dilatation,
+                     double nonlinearity_tolerance = 0.0) {
     const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
     if (!is_default && !wanted(label)) return;
-    const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, false, mean_dilatation);
+    const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, false, mean_dilatation,
+                                 nonlinearity_tolerance);
     add(tr, a, "reduced", label, K, dt, iters, is_default);
     BenchRow& r = rows.back();
     const double steps = double(tr.ms.size());
@@ -351,7 +354,10 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     r.ms_solve = tr.ms_solve / steps;
     r.peak_mib = tr.peak_mib;
     r.dynamic_ms_median =
-        percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true, mean_dilatation).ms, 0.5);
+        percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true, mean_dilatation,
+                               nonlinearity_tolerance)
+                       .ms,
+                   0.5);
   };
   const int K = o.default_handles;
   // Handle counts at the default time step and cubature, one Newton step.
@@ -365,6 +371,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   for (double dt : o.quick ? std::vector<double>{1.0 / 30.0} : std::vector<double>{1.0 / 30.0, 1.0 / 120.0})
     reduced(default_avatar, K, dt, 1, "dt=1/" + std::to_string(int(std::lround(1.0 / dt))), false);
   for (int iters : {2, 3}) reduced(default_avatar, K, h, iters, std::to_string(iters) + " Newton iterations", false);
+  reduced(default_avatar, K, h, 1, "second Newton iteration where the step is > 5 % off its quadratic model", false, md, 0.05);
   reduced(default_avatar, K, h, o.converged_newton_iters, "Newton converged", false);
   // Cubature variants: the stratified samples without the stiffness fit, more
   // or fewer candidates, and exact integration (one sample per tet) for the

@@ -153,6 +153,8 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
   bool final_valid = false;  // g_final/per_term hold the final configuration's values
   require(o.iterations_after_damping >= 0, "NewtonOptions::iterations_after_damping = ", o.iterations_after_damping,
           ", expected >= 0");
+  require(o.nonlinearity_tolerance >= 0 && std::isfinite(o.nonlinearity_tolerance),
+          "NewtonOptions::nonlinearity_tolerance = ", o.nonlinearity_tolerance, ", expected finite and >= 0");
   int planned = o.iterations;  // grows while the last iteration is damped (iterations_after_damping)
   for (int it = 0; it < planned; ++it) {
     Timer ta;
@@ -198,6 +200,7 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     }
     std::vector<Configuration> trial;
     bool ok = false;
+    double E_trial = E0;
     // An iteration added after a damped one must lower the step's objective (Armijo):
     // without that, on targets jumping ~3 rad (builtin:torture) the added iterations
     // carried the bones through in one step and crushed the flesh they drag.
@@ -213,6 +216,7 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
       const bool admissible = std::isfinite(E1);
       if (line_search ? (admissible && E1 <= E0 + kArmijo * alpha * capped_slope) : admissible) {
         ok = true;
+        E_trial = E1;
         break;
       }
       if (bones_capped && whole.size() > 0) {  // fall back to the whole step scaled to the caps
@@ -255,6 +259,14 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     if (outcome == StepOutcome::Damped && it + 1 == planned && planned < o.iterations + o.iterations_after_damping) {
       ++planned;
       ++rep.iterations_after_damping;
+    } else if (outcome == StepOutcome::Accepted && it + 1 == planned && !added && o.nonlinearity_tolerance > 0 &&
+               -slope > 1e-12 * std::max(1.0, std::abs(E0))) {
+      // The full Newton step predicts a decrease of ½ δᵀHδ = −½ gᵀδ.
+      const double rho = (E0 - E_trial) / (-0.5 * slope);
+      if (std::abs(rho - 1.0) > o.nonlinearity_tolerance) {
+        ++planned;
+        ++rep.iterations_for_nonlinearity;
+      }
     }
   }
 

@@ -18,6 +18,7 @@ std::string StepReport::summary() const {
   os << "t = " << time << " s: " << iterations << " Newton iteration(s), " << to_string(outcome) << " ("
      << accepted << " accepted, " << damped << " damped, " << rejected << " rejected";
   if (iterations_after_damping > 0) os << "; " << iterations_after_damping << " added after a damped one";
+  if (iterations_for_nonlinearity > 0) os << "; " << iterations_for_nonlinearity << " added for nonlinearity";
   os << ")\n";
   os << "  energy " << energy_before << " -> " << energy_after << " J, |grad| " << grad_norm_before << " -> "
      << grad_norm_after << ", Newton decrement " << newton_decrement << ", step scale " << step_scale << "\n";

@@ -327,6 +327,8 @@ TEST_F(BadInputMatrix, EveryEntryPointRejectsBadInputWithOneLine) {
       {sim + " --max-rotation-step nan", {"--max-rotation-step"}, {r}},
       {sim + " --newton-iters 0", {"--newton-iters"}, {r}},
       {sim + " --newton-iters 1000000", {"--newton-iters"}, {r}},
+      {sim + " --newton-nonlinearity-tol -0.1", {"--newton-nonlinearity-tol"}, {r}},
+      {sim + " --newton-nonlinearity-tol nan", {"--newton-nonlinearity-tol"}, {r}},
       {sim + " --render " + f("x.png") + " --render-frames 0", {"--render-frames"}, {r, f("x.png")}},
       {sim + " --bones sideways", {"--bones"}, {r}},
       {sim + " --units furlong --motion " + bvh, {"--units"}, {r}},

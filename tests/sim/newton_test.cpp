@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/energies/gravity.hpp"
@@ -206,6 +207,57 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
   }
   // One Newton step per time step stays close to the converged trajectory.
   EXPECT_LT((sim1.state().z - sim.state().z).norm(), 0.2 * sim.state().z.norm());
+}
+
+/// E(z) = Σ_i ½ a z_i² + ¼ b z_i⁴ − f z_i on the soft DoFs alone.
+struct QuarticTerm : EnergyTerm {
+  double a = 1, b = 0, f = 1;
+  std::string name() const override { return "quartic"; }
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override {
+    const int z0 = ctx.layout.z_offset();
+    double E = 0;
+    for (int i = 0; i < q.z.size(); ++i) {
+      const double z = q.z[i];
+      E += 0.5 * a * z * z + 0.25 * b * z * z * z * z - f * z;
+      if (grad) (*grad)[z0 + i] += a * z + b * z * z * z - f;
+      if (hess) (*hess)(z0 + i, z0 + i) += a + 3 * b * z * z;
+    }
+    return E;
+  }
+};
+
+/// NewtonOptions::nonlinearity_tolerance. From z = 0 the Newton step is f/a; the energy falls by
+/// ½ f²/a − ¼ b f⁴/a⁴ against the model's ½ f²/a, so ρ = 1 − ½ b f²/a³ (by hand): 0.9 for
+/// a = f = 1, b = 0.2. Then the second iteration goes from 1 to 1 − (1 + 0.2 − 1)/(1 + 0.6) =
+/// 0.875. A quadratic (b = 0) has ρ = 1 and takes no second iteration.
+TEST(Newton, AFullStepFarFromItsQuadraticModelGetsOneMoreIteration) {
+  StepContext ctx;
+  ctx.layout.bones_dynamic = false;
+  ctx.layout.num_bones = 0;
+  ctx.layout.num_reduced = 3;
+  QuarticTerm term;
+  term.b = 0.2;
+  NewtonOptions o;
+  o.max_z_step = 0;  // the steps here are 1 "m": no cap
+  o.nonlinearity_tolerance = 0.05;
+  Configuration q;
+  q.z = VecX::Zero(3);
+  StepReport rep = newton_minimize({&term}, ctx, q, o);
+  EXPECT_EQ(rep.iterations, 2) << rep.summary();
+  EXPECT_EQ(rep.iterations_for_nonlinearity, 1);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(q.z[i], 0.875, 1e-15);
+  // Within the tolerance (|ρ − 1| = 0.1 < 0.2), off (0) and a quadratic: one iteration, z = f/a.
+  for (const auto& [tol, b] : {std::pair{0.2, 0.2}, std::pair{0.0, 0.2}, std::pair{1e-9, 0.0}}) {
+    term.b = b;
+    o.nonlinearity_tolerance = tol;
+    q.z = VecX::Zero(3);
+    rep = newton_minimize({&term}, ctx, q, o);
+    EXPECT_EQ(rep.iterations, 1) << "tolerance " << tol << ", b " << b;
+    EXPECT_EQ(rep.iterations_for_nonlinearity, 0);
+    EXPECT_NEAR(q.z[0], 1.0, 1e-15);
+  }
+  o.nonlinearity_tolerance = -1;
+  EXPECT_THROW(newton_minimize({&term}, ctx, q, o), Error);
 }
 
 }  // namespace

@@ -48,6 +48,9 @@ struct StepReport {
   /// Of `iterations`, those added because the planned last one was damped
   /// (NewtonOptions::iterations_after_damping).
   int iterations_after_damping = 0;
+  /// Of `iterations`, those added because the last planned one's energy
+  /// change departed from the quadratic model (NewtonOptions::nonlinearity_tolerance).
+  int iterations_for_nonlinearity = 0;
   StepOutcome outcome = StepOutcome::Accepted;  ///< worst outcome over the iterations
   double ms_assemble = 0;             ///< ms evaluating energies, gradients, Hessians
   double ms_solve = 0;                ///< ms in the Cholesky factorization and solve
