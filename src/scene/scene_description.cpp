@@ -476,7 +476,7 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
 }
 
 SolverDescription parse_solver(const SceneParser& p, const YAML::Node& n) {
-  p.check_map(n, "solver", {"dt", "seconds", "newton_iters", "iterations_after_damping", "line_search", "gravity", "damping"}, "the solver settings");
+  p.check_map(n, "solver", {"dt", "seconds", "newton_iters", "iterations_after_damping", "line_search", "nonlinearity_tolerance", "gravity", "damping"}, "the solver settings");
   SolverDescription s;
   if (const auto v = n["dt"]) {
     if (!v.IsScalar()) p.error(v, "solver.dt", "expected a time step such as 1/60 or 0.01");
@@ -491,6 +491,8 @@ SolverDescription parse_solver(const SceneParser& p, const YAML::Node& n) {
   if (const auto v = n["iterations_after_damping"])
     s.iterations_after_damping = p.integer(v, "solver.iterations_after_damping", 0, 100);
   if (const auto v = n["line_search"]) s.line_search = p.boolean(v, "solver.line_search");
+  if (const auto v = n["nonlinearity_tolerance"])
+    s.nonlinearity_tolerance = p.non_negative(v, "solver.nonlinearity_tolerance");
   if (const auto v = n["gravity"]) s.gravity = p.vec3(v, "solver.gravity");
   if (const auto v = n["damping"]) s.damping = p.non_negative(v, "solver.damping");
   return s;
@@ -761,7 +763,8 @@ std::string scene_description_yaml(const SceneDescription& scene) {
   e << YAML::Key << "solver" << YAML::Value << YAML::BeginMap << YAML::Key << "dt" << YAML::Value << num(s.dt) << YAML::Key
     << "seconds" << YAML::Value << num(s.seconds) << YAML::Key << "newton_iters" << YAML::Value << s.newton_iterations
     << YAML::Key << "iterations_after_damping" << YAML::Value << s.iterations_after_damping
-    << YAML::Key << "line_search" << YAML::Value << s.line_search << YAML::Key << "gravity" << YAML::Value;
+    << YAML::Key << "line_search" << YAML::Value << s.line_search << YAML::Key << "nonlinearity_tolerance"
+    << YAML::Value << num(s.nonlinearity_tolerance) << YAML::Key << "gravity" << YAML::Value;
   emit(e, s.gravity);
   e << YAML::Key << "damping" << YAML::Value << num(s.damping) << YAML::EndMap;
 

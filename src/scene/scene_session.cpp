@@ -283,6 +283,7 @@ void SceneSession::Impl::build() {
   mo.newton.iterations = sc.solver.newton_iterations;
   mo.newton.line_search = sc.solver.line_search;
   mo.newton.iterations_after_damping = sc.solver.iterations_after_damping;
+  mo.newton.nonlinearity_tolerance = sc.solver.nonlinearity_tolerance;
   ModelBuilder mb(mo);
   auto in_body_contact = [&](const BodyDescription& d) {
     for (const BodyDescription& other : sc.bodies)

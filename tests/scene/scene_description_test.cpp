@@ -249,6 +249,8 @@ objects:
                      {"scene.yaml:4:", "bodies[0].placement.offset", "list of 3 numbers"});
   expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1, line_search: maybe}\n",
                      {"scene.yaml:4:", "solver.line_search", "true or false"});
+  expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1, nonlinearity_tolerance: -0.1}\n",
+                     {"scene.yaml:4:", "solver.nonlinearity_tolerance"});
   expect_scene_error("bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1, newton_iters: 1.5}\n",
                      {"scene.yaml:4:", "solver.newton_iters", "integer"});
   expect_scene_error("bodies: {name: a}\n", {"scene.yaml:1:", "bodies", "list of at least one body"});
@@ -409,7 +411,9 @@ SceneDescription full_scene(const SceneFolder& folder) {
   s.solver.dt = 1.0 / 90;
   s.solver.seconds = 2.5;
   s.solver.newton_iterations = 4;
+  s.solver.iterations_after_damping = 7;
   s.solver.line_search = true;
+  s.solver.nonlinearity_tolerance = 0.0625;
   s.solver.gravity = Vec3(0.1, -3.7, 0.2);
   s.solver.damping = 0.002;
 
@@ -507,7 +511,9 @@ TEST(SceneDescription, FullRoundTripKeepsEveryField) {
   EXPECT_FIELD(solver.dt);
   EXPECT_FIELD(solver.seconds);
   EXPECT_FIELD(solver.newton_iterations);
+  EXPECT_FIELD(solver.iterations_after_damping);
   EXPECT_FIELD(solver.line_search);
+  EXPECT_FIELD(solver.nonlinearity_tolerance);
   EXPECT_FIELD(solver.gravity);
   EXPECT_FIELD(solver.damping);
   EXPECT_FIELD(output.out);

@@ -19,6 +19,9 @@
 //     newton_iters: 1           # Newton iterations per step, 1..100; default 1
 //     iterations_after_damping: 3  # more iterations while the last one is damped by a cap, 0..100; default 3
 //     line_search: false        # backtracking line search; default false
+//     nonlinearity_tolerance: 0 # one more Newton iteration where a full step's energy change is
+//                               # off its quadratic model by more than this share (|rho - 1|;
+//                               # 0.05 suits prescribed bones), >= 0; default 0 = off
 //     gravity: [0, -9.81, 0]    # m/s^2, world, Y up; default [0, -9.81, 0]
 //     damping: 0                # stiffness-proportional soft-tissue damping (s, >= 0); default 0
 //   output:                     # paths relative to the working folder (like the CLI flags)
@@ -261,6 +264,7 @@ struct SolverDescription {
   int newton_iterations = 1;
   int iterations_after_damping = NewtonOptions{}.iterations_after_damping;  ///< NewtonOptions'
   bool line_search = false;
+  double nonlinearity_tolerance = NewtonOptions{}.nonlinearity_tolerance;  ///< NewtonOptions'
   Vec3 gravity = Vec3(0, -9.81, 0);     ///< m/s²
   double damping = 0;                   ///< s
 };
