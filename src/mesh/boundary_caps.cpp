@@ -26,6 +26,16 @@ Face tet_face(const Tets& e, int t, int i) {
   return sorted_face(v[0], v[1], v[2]);
 }
 
+/// How many tets hold each face and each node.
+void count_faces_and_node_tets(const TetMesh& mesh, std::map<Face, int>& face_count, std::vector<int>& node_tets) {
+  node_tets.assign(size_t(mesh.num_nodes()), 0);
+  for (int t = 0; t < mesh.num_elements(); ++t)
+    for (int i = 0; i < 4; ++i) {
+      ++face_count[tet_face(mesh.elements, t, i)];
+      ++node_tets[size_t(mesh.elements(t, i))];
+    }
+}
+
 }  // namespace
 
 BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
@@ -36,12 +46,8 @@ BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char
   BoundaryCapReport rep;
   std::vector<char> alive(T, 1);
   std::map<Face, int> face_count;  // faces of the alive tets
-  std::vector<int> node_tets(N, 0);
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 4; ++i) {
-      ++face_count[tet_face(mesh.elements, t, i)];
-      ++node_tets[mesh.elements(t, i)];
-    }
+  std::vector<int> node_tets;
+  count_faces_and_node_tets(mesh, face_count, node_tets);
   // Boundary faces per edge (a < b), kept up to date as tets go.
   std::map<std::pair<int, int>, int> edge_boundary;
   auto edge = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
@@ -116,12 +122,8 @@ BoundaryCapReport remove_bad_boundary_ears(TetMesh& mesh, const std::vector<char
   BoundaryCapReport rep;
   std::vector<char> alive(T, 1), node_alive(N, 1);
   std::map<Face, int> face_count;  // faces of the alive tets
-  std::vector<int> node_tets(N, 0);
-  for (int t = 0; t < T; ++t)
-    for (int i = 0; i < 4; ++i) {
-      ++face_count[tet_face(mesh.elements, t, i)];
-      ++node_tets[mesh.elements(t, i)];
-    }
+  std::vector<int> node_tets;
+  count_faces_and_node_tets(mesh, face_count, node_tets);
   // The apex of tet t when three of its faces are boundary faces (else −1).
   auto ear_apex = [&](int t) {
     int nb = 0, apex = -1;

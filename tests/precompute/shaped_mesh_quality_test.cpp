@@ -31,6 +31,16 @@ PrecomputeOptions coarse() {
   return o;
 }
 
+/// The MakeHuman base human converted (data_tools/makehuman_to_smpl.py) into `dir`.
+BodyModel makehuman_model(const std::string& folder, const test::TempDir& dir) {
+  std::string log;
+  const int rc = test::run_command("/usr/bin/python3 " + test::source_dir() + "/data_tools/makehuman_to_smpl.py " +
+                                       folder + " " + dir.file("mh.h5"),
+                                   &log);
+  require(rc == 0, "makehuman_to_smpl.py failed: ", log);
+  return load_body_model(dir.file("mh.h5"));
+}
+
 void expect_quality(const TemplateVolume& tv, const BodyModel& model, const std::string& name, const VecX& betas) {
   const ShapedVolume s = shape_volume(tv, model, betas, ThicknessMap::defaults());
   const TetQualityReport& q = s.report.quality;
@@ -61,13 +71,7 @@ TEST(ShapedMeshQuality, MakeHumanHardestTargets) {
   const std::string folder = test::shared_data("makehuman");
   if (folder.empty()) GTEST_SKIP() << "../shared/data/makehuman is absent (the MakeHuman base human); skipping";
   test::TempDir dir;
-  std::string log;
-  ASSERT_EQ(test::run_command("/usr/bin/python3 " + test::source_dir() + "/data_tools/makehuman_to_smpl.py " +
-                                  folder + " " + dir.file("mh.h5"),
-                              &log),
-            0)
-      << log;
-  const BodyModel model = load_body_model(dir.file("mh.h5"));
+  const BodyModel model = makehuman_model(folder, dir);
   const TemplateVolume tv = cached_template_volume(model, coarse());
   const int B = model.num_betas();
   // Rows of makehuman_to_smpl.py --target-betas (beta = +-3 in the directions that make the target).
@@ -109,7 +113,9 @@ void expect_fields_follow_template(const TemplateVolume& tv, const ShapedVolume&
   for (int i = 0; i < tv.outer_nodes.size(); ++i) outer[tv.outer_nodes[i]] = 1;
   for (int i = 0; i < s.template_nodes.size(); ++i) {
     const int n = s.template_nodes[i];
-    if (i > 0) ASSERT_GT(n, s.template_nodes[i - 1]) << name;
+    if (i > 0) {
+      ASSERT_GT(n, s.template_nodes[i - 1]) << name;
+    }
     kept[n] = 1;
     ASSERT_EQ(a.node_weights.row(i), tv.node_weights.row(n)) << name << " node " << i;
     ASSERT_EQ(a.node_role[i], tv.node_role[n]) << name << " node " << i;
@@ -134,13 +140,7 @@ TEST(ShapedMeshQuality, MakeHumanCornersThatNeedAnEarRemovedOrASkinEdgeFlipped) 
   const std::string folder = test::shared_data("makehuman");
   if (folder.empty()) GTEST_SKIP() << "../shared/data/makehuman is absent (the MakeHuman base human); skipping";
   test::TempDir dir;
-  std::string log;
-  ASSERT_EQ(test::run_command("/usr/bin/python3 " + test::source_dir() + "/data_tools/makehuman_to_smpl.py " +
-                                  folder + " " + dir.file("mh.h5"),
-                              &log),
-            0)
-      << log;
-  const BodyModel model = load_body_model(dir.file("mh.h5"));
+  const BodyModel model = makehuman_model(folder, dir);
   PrecomputeOptions full;
   full.bbw.show_progress = false;
   const TemplateVolume tv = cached_template_volume(model, full);
