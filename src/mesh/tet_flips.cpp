@@ -43,6 +43,21 @@ double orient_and_rate(const Points& x, std::vector<Tet>& tets) {
   return worst;
 }
 
+// Orients each candidate tet positively on its own (for new tets on opposite
+// sides of a shared face); returns their smallest dihedral angle, or -1 if any
+// is degenerate.
+double orient_each_and_rate(const Points& x, std::vector<Tet>& tets) {
+  double worst = 180;
+  bool degenerate = false;
+  for (Tet& t : tets) {
+    const double v = quality(x, t).signed_volume;
+    degenerate = degenerate || v == 0;
+    if (v < 0) std::swap(t[2], t[3]);
+    worst = std::min(worst, quality(x, t).min_dihedral_deg);
+  }
+  return degenerate ? -1 : worst;
+}
+
 // The new tets fill exactly the old ones (the flip is geometric, not just
 // combinatorial): equal total volume, relative to the old one.
 bool same_volume(const Points& x, const std::vector<Tet>& fresh, const std::vector<Tet>& old) {
@@ -161,21 +176,14 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
           if (!closed || !face_tets[key(others[0], others[1], others[2])].empty()) continue;
           std::vector<Tet> fresh = {{others[0], others[1], others[2], a}, {others[0], others[1], others[2], b}};
           // The two must lie on opposite sides of the new face: orient each on its own.
-          double worst = 180;
-          bool valid = true;
-          for (Tet& n : fresh) {
-            const double v = quality(x, n).signed_volume;
-            if (v == 0) valid = false;
-            if (v < 0) std::swap(n[2], n[3]);
-            worst = std::min(worst, quality(x, n).min_dihedral_deg);
-          }
+          const double worst = orient_each_and_rate(x, fresh);
           const double before = std::min({rate(ring[0]), rate(ring[1]), rate(ring[2])});
           // Opposite sides: a and b on different sides of the face (others).
           const Vec3 p0 = x.row(others[0]).transpose(), p1 = x.row(others[1]).transpose(),
                      p2 = x.row(others[2]).transpose();
           const Vec3 nrm = (p1 - p0).cross(p2 - p0);
           const double sa = nrm.dot(x.row(a).transpose() - p0), sb = nrm.dot(x.row(b).transpose() - p0);
-          if (valid && sa * sb < 0 && worst > before + 1e-9 &&
+          if (sa * sb < 0 && worst > before + 1e-9 &&
               same_volume(x, fresh, {tets[ring[0]], tets[ring[1]], tets[ring[2]]})) {
             m.replace(ring, fresh);
             ++rep.flips_3_2;
@@ -234,15 +242,8 @@ TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on
           const Vec3 pa = point(node_a), n = (point(node_b) - pa).cross(point(inner) - pa);
           if (n.dot(point(q) - pa) * n.dot(point(r) - pa) >= 0) continue;  // q, r on one side: not a flip
           std::vector<Tet> fresh = {{node_a, node_b, q, inner}, {node_a, node_b, r, inner}};
-          double worst = 180;
-          bool valid = true;
-          for (Tet& nt : fresh) {  // each on its own: they lie on opposite sides of (a, b, i)
-            const double v = quality(x, nt).signed_volume;
-            if (v == 0) valid = false;
-            if (v < 0) std::swap(nt[2], nt[3]);
-            worst = std::min(worst, quality(x, nt).min_dihedral_deg);
-          }
-          if (!valid || worst <= std::min(rate(fan[0]), rate(fan[1])) + 1e-9) continue;
+          // Each oriented on its own: they lie on opposite sides of (a, b, i).
+          if (orient_each_and_rate(x, fresh) <= std::min(rate(fan[0]), rate(fan[1])) + 1e-9) continue;
           m.replace(fan, fresh);
           ++rep.flips_2_2;
           done = true;

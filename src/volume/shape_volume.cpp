@@ -240,7 +240,14 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   // skin-only tets, which the template stage cannot move): the skin nodes
   // slide along the skin below.
   const double quality_floor = o.quality_floor_deg;
-  std::vector<int> kept_tets;
+  // The template tet each avatar tet comes from; `parent` (#T', indices into
+  // the current tets) of an operation that removes or replaces tets composes into it.
+  std::vector<int> kept_tets(size_t(tv.tet.num_elements()));
+  std::iota(kept_tets.begin(), kept_tets.end(), 0);
+  auto follow = [&](std::vector<int> parent) {
+    for (int& t : parent) t = kept_tets[size_t(t)];
+    kept_tets = std::move(parent);
+  };
   auto remove_caps = [&] {
     // Tets with all four nodes on the skin and two faces on it, which the
     // shape flattened or turned inside out by making a convex ridge of the
@@ -248,12 +255,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     if (!o.remove_bad_caps || o.smoothing.passes == 0) return;
     std::vector<int> kept;
     out.report.caps_removed += remove_bad_boundary_caps(av.tet, on_skin, quality_floor, &kept).removed;
-    if (kept_tets.empty()) {
-      kept_tets = kept;
-    } else {
-      for (int& t : kept) t = kept_tets[t];
-      kept_tets = kept;
-    }
+    follow(std::move(kept));
   };
   remove_caps();
   if (o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
@@ -290,9 +292,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       // skin surface), 2-3 and 3-2 flips; then the node moves once more.
       std::vector<int> parent;
       out.report.flips = flip_bad_tets(av.tet, o.smoothing.target_deg, o.flip_rounds, &parent);
-      if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
-      for (int& t : parent) t = kept_tets[t];
-      kept_tets = parent;
+      follow(parent);
       // Skin nodes of the tets still below the floor may slide further.
       auto slide_skin_of_bad_tets = [&] {
         for (int t = 0; t < av.tet.num_elements(); ++t)
@@ -314,8 +314,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       if (tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
         out.report.flips.flips_2_2 =
             flip_bad_boundary_edges(av.tet, on_skin, quality_floor, o.flip_rounds, &parent).flips_2_2;
-        for (int& t : parent) t = kept_tets[t];
-        kept_tets = parent;
+        follow(parent);
         if (out.report.flips.flips_2_2 > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor)
           slide_skin_of_bad_tets();
       }
@@ -331,18 +330,11 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     std::vector<int> kept, nodes;
     out.report.ears_removed = remove_bad_boundary_ears(av.tet, on_skin, quality_floor, &kept, &nodes).removed;
     if (out.report.ears_removed > 0) {
-      if (kept_tets.empty()) kept_tets.resize(tv.tet.num_elements()), std::iota(kept_tets.begin(), kept_tets.end(), 0);
-      for (int& t : kept) t = kept_tets[t];
-      kept_tets = kept;
+      follow(std::move(kept));
       tn = Eigen::Map<const VecXi>(nodes.data(), Eigen::Index(nodes.size()));
     }
   }
-  if (kept_tets.empty()) {
-    av.tet_region = tv.tet_region;
-  } else {
-    av.tet_region.resize(kept_tets.size());
-    for (size_t i = 0; i < kept_tets.size(); ++i) av.tet_region[i] = tv.tet_region[kept_tets[i]];
-  }
+  av.tet_region = tv.tet_region(Eigen::Map<const VecXi>(kept_tets.data(), Eigen::Index(kept_tets.size())));
   out.report.quality = tet_quality_report(av.tet);
   if (out.report.quality.num_inverted > 0 || out.report.quality.min_dihedral_deg < o.quality_floor_deg)
     out.report.skin_self_intersects = check_surface(v_shaped, F, true).self_intersects ? 1 : 0;
