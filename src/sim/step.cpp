@@ -139,6 +139,8 @@ void merge_report(StepReport& total, StepReport& g, const std::vector<int>& term
   total.step_scale = std::min(total.step_scale, g.step_scale);
   total.regularization = std::max(total.regularization, g.regularization);
   total.iterations = std::max(total.iterations, g.iterations);
+  total.iterations_after_damping = std::max(total.iterations_after_damping, g.iterations_after_damping);
+  total.iterations_for_nonlinearity = std::max(total.iterations_for_nonlinearity, g.iterations_for_nonlinearity);
   total.accepted += g.accepted;
   total.damped += g.damped;
   total.rejected += g.rejected;
