@@ -20,6 +20,7 @@ struct BenchArgs {
   std::string motion = "builtin:jump", out = "bench", model = "procedural", betas, handles, cache_dir;
   std::vector<std::string> only;
   int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
+  int variants_handles = BenchOptions().default_handles;
   double seconds = 0;
   bool seconds_given = false;
 };
@@ -54,6 +55,9 @@ void run_bench(const BenchArgs& a) {
       o.handle_counts.push_back(int(k[i]));
     }
   }
+  require(a.variants_handles >= 1 && a.variants_handles <= 2000, "--variants-handles must be in [1, 2000], got ",
+          a.variants_handles);
+  o.default_handles = a.variants_handles;
   if (!a.no_cache) o.precompute.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
   require(!a.seconds_given || (std::isfinite(a.seconds) && a.seconds > 0),
           "--seconds must be a positive number of seconds, got ", a.seconds);
@@ -87,6 +91,10 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
   cmd->add_option("--model", a->model, "Body model")->capture_default_str();
   cmd->add_option("--betas", a->betas, "Body shape b0,b1,...");
   cmd->add_option("--handles", a->handles, "Handle counts, e.g. 16,32,64,128");
+  cmd->add_option("--variants-handles", a->variants_handles,
+                  "K of the row marked default and of every variant row (time step, Newton, cubature...); added "
+                  "to --handles if missing")
+      ->capture_default_str();
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
   cmd->add_option("--only", a->only,
                   "Run only the variants whose label contains one of these strings (the reference, the default "

@@ -32,6 +32,7 @@ struct PrecomputeArgs {
   int handles = 64;
   int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
   int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
+  int handles_min_per_region = PrecomputeOptions().placement.min_per_region;
   bool no_fit_cubature = false;
   std::string handles_file, thickness_map, out = "avatar.h5", batch, out_dir, cache_dir;
   bool no_cache = false, template_only = false, dry_run = false;
@@ -52,6 +53,9 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
   require(a.inertia_samples_per_cell >= 0 && a.inertia_samples_per_cell <= 1000,
           "--inertia-samples-per-cell must be in [0, 1000], got ", a.inertia_samples_per_cell);
   o.inertia_samples_per_cell = a.inertia_samples_per_cell;
+  require(a.handles_min_per_region >= 0 && a.handles_min_per_region <= a.handles,
+          "--handles-min-per-region must be in [0, --handles = ", a.handles, "], got ", a.handles_min_per_region);
+  o.placement.min_per_region = a.handles_min_per_region;
   if (!a.handles_file.empty()) o.handle_positions = read_handles_file(a.handles_file);
   if (!a.thickness_map.empty()) o.thickness = read_thickness_map(a.thickness_map);
   if (!a.no_cache) o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
@@ -86,7 +90,8 @@ std::vector<std::string> worker_command(const PrecomputeArgs& a, const Precomput
   std::vector<std::string> c = {self_executable(), "-q", "precompute", "--model", a.model, "--handles",
                                 std::to_string(a.handles), "--elastic-samples-per-cell",
                                 std::to_string(a.elastic_samples_per_cell), "--inertia-samples-per-cell",
-                                std::to_string(a.inertia_samples_per_cell), "--cache-dir", o.cache_dir};
+                                std::to_string(a.inertia_samples_per_cell), "--handles-min-per-region",
+                                std::to_string(a.handles_min_per_region), "--cache-dir", o.cache_dir};
   if (a.no_fit_cubature) c.push_back("--no-fit-cubature");
   for (const auto& [flag, value] : {std::pair<const char*, const std::string*>{"--handles-file", &a.handles_file},
                                     {"--thickness-map", &a.thickness_map}})
@@ -293,6 +298,11 @@ const CommandRegistrar reg(20, [](CLI::App& app) {
   cmd->add_option("--inertia-samples-per-cell", a->inertia_samples_per_cell,
                   "Inertia cubature: candidate nodes per cell, weights fitted to the lumped mass matrix "
                   "(0 = one data-oblivious sample per handle)")
+      ->capture_default_str();
+  cmd->add_option("--handles-min-per-region", a->handles_min_per_region,
+                  "Handles at least in every body region with >= 1 % of the allocation weight (soft volume x "
+                  "thickness^0.5; the rest go by that weight; "
+                  "more gives the limbs and neck finer soft DoFs at the torso's expense)")
       ->capture_default_str();
   cmd->add_flag("--no-fit-cubature", a->no_fit_cubature,
                 "Keep the stratified elastic cubature's volume weights (no stiffness fit)");

@@ -362,7 +362,9 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   const int K = o.default_handles;
   // Handle counts at the default time step and cubature, one Newton step.
   for (size_t i = 0; i < avatars.size(); ++i)
-    reduced(avatars[i], o.handle_counts[i], h, 1, o.handle_counts[i] == K ? "default" : "", o.handle_counts[i] == K);
+    reduced(avatars[i], o.handle_counts[i], h, 1,
+            o.handle_counts[i] != K ? "" : K == PrecomputeOptions().handles ? "default" : "default settings otherwise",
+            o.handle_counts[i] == K);
   // Mean dilatation per handle cell (against the subspace's volumetric
   // locking, issue 13) against every tet's own volume change, as before.
   const bool md = SimulatorOptions().mean_dilatation;
@@ -397,6 +399,18 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     log_info("bench: shape stage with bones " + std::string(dirichlet ? "Dirichlet" : "depth-blended"));
     const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
     reduced(a, K, h, 1, dirichlet ? "bones Dirichlet 0 (before issue 13)" : "bones depth-blended", false);
+  }
+  // Handle allocation (issue 13's "handle placement"): more handles for the
+  // small regions (calf, arms, neck, chest) at the same K, taken from the
+  // large ones by the same apportionment.
+  for (int m : {4, 6}) {
+    const std::string what = "at least " + std::to_string(m) + " handles per region";
+    if (m == o.precompute.placement.min_per_region || !wanted(what)) continue;
+    PrecomputeOptions po = o.precompute;
+    po.handles = K;
+    po.placement.min_per_region = m;
+    log_info("bench: shape stage with " + what);
+    reduced(std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po)), K, h, 1, what, false);
   }
   const PrecomputeOptions defaults = o.precompute;
   cubature_variant(defaults.elastic_samples_per_cell, !defaults.fit_elastic_cubature,

@@ -8,8 +8,12 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <numeric>
 
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/basis/basis_coverage.hpp"
+#include "sflsh/basis/handle_placement.hpp"
+#include "sflsh/body/body_model_io.hpp"
 #include "sflsh/precompute/batch_precompute.hpp"
 #include "test_support.hpp"
 
@@ -220,4 +224,38 @@ TEST_F(BatchCli, DaskLocalClusterOfTwoWorkersBuildsEveryRow) {
     EXPECT_EQ(m[row].status, "exists") << row;
     EXPECT_EQ(read_avatar(m[row].file).betas[0], row - 1.0);
   }
+}
+
+/// `--handles-min-per-region`: every region the default gives its minimum of 2
+/// handles gets at least 3 with the flag at 3, from the same K (taken from the
+/// large regions), and the batch content key tells the two settings apart.
+TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
+  const std::string coarse = " --cell-size 0.08 --facet-size 0.06 --facet-distance 0.004 --cache-dir " +
+                             dir_->file("cache") + " --handles 40";
+  auto counts = [&](const std::string& flag, const std::string& name) {
+    std::string out;
+    EXPECT_EQ(test::run_command(test::sflsh_binary() + " -q precompute" + coarse + flag + " --out " + dir_->file(name),
+                                &out),
+              0)
+        << out;
+    const Avatar a = read_avatar(dir_->file(name));
+    const int R = int(a.materials.size());
+    const VecXi node_region = basis::node_regions_from_tets(a.tet, a.tet_region, R);
+    std::vector<int> n(size_t(R), 0);
+    for (int node : basis::nearest_nodes(a.tet.nodes, a.handles)) ++n[size_t(node_region[node])];
+    return n;
+  };
+  const std::vector<int> two = counts("", "min2.h5"), three = counts(" --handles-min-per-region 3", "min3.h5");
+  int at_two = 0;
+  for (size_t r = 0; r < two.size(); ++r) {
+    if (two[r] == 2) ++at_two;
+    if (two[r] >= 2) EXPECT_GE(three[r], 3) << "region " << r;
+  }
+  EXPECT_GT(at_two, 0) << "no region at the default minimum: the test would not see the flag";
+  EXPECT_EQ(std::accumulate(two.begin(), two.end(), 0), 40);
+  EXPECT_EQ(std::accumulate(three.begin(), three.end(), 0), 40);
+  PrecomputeOptions o2, o3;
+  o3.placement.min_per_region = 3;
+  const BodyModel model = load_body_model("procedural");
+  EXPECT_NE(avatar_content_key(model, VecX::Zero(10), o2), avatar_content_key(model, VecX::Zero(10), o3));
 }
