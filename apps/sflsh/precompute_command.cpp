@@ -29,7 +29,7 @@ namespace {
 struct PrecomputeArgs {
   std::string model = "procedural";
   std::string betas;
-  int handles = 64;
+  int handles = PrecomputeOptions().handles;
   int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
   int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
   int handles_min_per_region = PrecomputeOptions().placement.min_per_region;

@@ -1,6 +1,7 @@
 // `sflsh simulate`: drive an avatar with a motion, write the result cache,
 // optional exports and a picture.
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -34,7 +35,7 @@ struct SimulateArgs {
   double max_rotation_step = NewtonOptions{}.max_rotation_step;
   int newton_iters = 1, render_frames = 6;
   int iterations_after_damping = NewtonOptions{}.iterations_after_damping;
-  double nonlinearity_tolerance = NewtonOptions{}.nonlinearity_tolerance;
+  std::string nonlinearity_tolerance = "auto";
   long inject_nan_at_step = 0;  // test only (hidden option)
   bool line_search = false, use_file_betas = false, start_at_rest = false,
        mean_dilatation = SimulatorOptions().mean_dilatation;
@@ -116,9 +117,17 @@ void run_simulate(const SimulateArgs& a) {
   require(a.iterations_after_damping >= 0 && a.iterations_after_damping <= 100,
           "--iterations-after-damping must be in [0, 100], got ", a.iterations_after_damping);
   o.sim.newton.iterations_after_damping = a.iterations_after_damping;
-  require(std::isfinite(a.nonlinearity_tolerance) && a.nonlinearity_tolerance >= 0,
-          "--newton-nonlinearity-tol must be a number >= 0, got ", a.nonlinearity_tolerance);
-  o.sim.newton.nonlinearity_tolerance = a.nonlinearity_tolerance;
+  if (a.nonlinearity_tolerance != "auto") {
+    double tol = std::numeric_limits<double>::quiet_NaN();
+    size_t used = 0;
+    try {
+      tol = std::stod(a.nonlinearity_tolerance, &used);
+    } catch (const std::exception&) {
+    }
+    require(used == a.nonlinearity_tolerance.size() && std::isfinite(tol) && tol >= 0,
+            "--newton-nonlinearity-tol must be 'auto' or a number >= 0, got '", a.nonlinearity_tolerance, "'");
+    o.sim.newton.nonlinearity_tolerance = tol;
+  }
   require(a.damping >= 0, "--damping must be >= 0");
   o.sim.damping = a.damping;
   o.sim.mean_dilatation = a.mean_dilatation;
@@ -243,7 +252,8 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--newton-nonlinearity-tol", a->nonlinearity_tolerance,
                   "One more Newton iteration (with line search) when a full step's energy change departs from the "
-                  "quadratic model's by more than this share (|rho - 1|; 0.05 suits prescribed bones; 0: off)")
+                  "quadratic model's by more than this share (|rho - 1|; 0: off; auto: 0.05 with --bones "
+                  "kinematic, off with dynamic bones, whose rotations would trigger it on most steps)")
       ->capture_default_str();
   cmd->add_option("--bones", a->bones, "'dynamic' (bones are DoFs tracking the motion) or 'kinematic' (prescribed)")
       ->capture_default_str();

@@ -79,6 +79,8 @@ SurfaceRun simulate_surface(const Avatar& avatar, const FitParameters& params, c
   SimulatorOptions so;
   so.h = seq.h;
   so.bones_dynamic = false;
+  // The sensitivities below differentiate one Newton step per time step.
+  so.newton.nonlinearity_tolerance = 0.0;
   so.damping = beta;
   so.gravity = Vec3(0, seq.gravity_y, 0);
   Simulator sim(avatar_model(av, so));

@@ -491,8 +491,9 @@ SolverDescription parse_solver(const SceneParser& p, const YAML::Node& n) {
   if (const auto v = n["iterations_after_damping"])
     s.iterations_after_damping = p.integer(v, "solver.iterations_after_damping", 0, 100);
   if (const auto v = n["line_search"]) s.line_search = p.boolean(v, "solver.line_search");
-  if (const auto v = n["nonlinearity_tolerance"])
-    s.nonlinearity_tolerance = p.non_negative(v, "solver.nonlinearity_tolerance");
+  if (const auto v = n["nonlinearity_tolerance"]) {
+    if (!(v.IsScalar() && v.Scalar() == "auto")) s.nonlinearity_tolerance = p.non_negative(v, "solver.nonlinearity_tolerance");
+  }
   if (const auto v = n["gravity"]) s.gravity = p.vec3(v, "solver.gravity");
   if (const auto v = n["damping"]) s.damping = p.non_negative(v, "solver.damping");
   return s;
@@ -764,7 +765,8 @@ std::string scene_description_yaml(const SceneDescription& scene) {
     << "seconds" << YAML::Value << num(s.seconds) << YAML::Key << "newton_iters" << YAML::Value << s.newton_iterations
     << YAML::Key << "iterations_after_damping" << YAML::Value << s.iterations_after_damping
     << YAML::Key << "line_search" << YAML::Value << s.line_search << YAML::Key << "nonlinearity_tolerance"
-    << YAML::Value << num(s.nonlinearity_tolerance) << YAML::Key << "gravity" << YAML::Value;
+    << YAML::Value << (s.nonlinearity_tolerance ? num(*s.nonlinearity_tolerance) : std::string("auto")) << YAML::Key
+    << "gravity" << YAML::Value;
   emit(e, s.gravity);
   e << YAML::Key << "damping" << YAML::Value << num(s.damping) << YAML::EndMap;
 

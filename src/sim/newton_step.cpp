@@ -106,6 +106,13 @@ void solve_in_place(MatX& H, const VecX& g, double eps, VecX& delta, double* shi
        "; a DoF without any energy or a NaN in a term?");
 }
 
+/// Whether every DoF of the step is a body's soft tissue (z): no dynamic bone, rigid body or tool.
+bool only_soft_dofs(const StepSystem& sys) {
+  int soft = 0;
+  for (const DofLayout& b : sys.bodies) soft += b.num_reduced;
+  return soft == sys.size;
+}
+
 }  // namespace
 
 TermPlacement TermPlacement::from_ranges(std::vector<std::pair<int, int>> ranges) {
@@ -153,8 +160,11 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
   bool final_valid = false;  // g_final/per_term hold the final configuration's values
   require(o.iterations_after_damping >= 0, "NewtonOptions::iterations_after_damping = ", o.iterations_after_damping,
           ", expected >= 0");
-  require(o.nonlinearity_tolerance >= 0 && std::isfinite(o.nonlinearity_tolerance),
-          "NewtonOptions::nonlinearity_tolerance = ", o.nonlinearity_tolerance, ", expected finite and >= 0");
+  require(!o.nonlinearity_tolerance || (*o.nonlinearity_tolerance >= 0 && std::isfinite(*o.nonlinearity_tolerance)),
+          "NewtonOptions::nonlinearity_tolerance = ", o.nonlinearity_tolerance.value_or(0),
+          ", expected finite and >= 0 (or unset: automatic)");
+  const double nonlinearity_tolerance = o.nonlinearity_tolerance.value_or(
+      only_soft_dofs(sys) ? kAutoNonlinearityTolerance : 0.0);
   int planned = o.iterations;  // grows while the last iteration is damped (iterations_after_damping)
   for (int it = 0; it < planned; ++it) {
     Timer ta;
@@ -259,11 +269,11 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     if (outcome == StepOutcome::Damped && it + 1 == planned && planned < o.iterations + o.iterations_after_damping) {
       ++planned;
       ++rep.iterations_after_damping;
-    } else if (outcome == StepOutcome::Accepted && it + 1 == planned && !added && o.nonlinearity_tolerance > 0 &&
+    } else if (outcome == StepOutcome::Accepted && it + 1 == planned && !added && nonlinearity_tolerance > 0 &&
                -slope > 1e-12 * std::max(1.0, std::abs(E0))) {
       // The full Newton step predicts a decrease of ½ δᵀHδ = −½ gᵀδ.
       const double rho = (E0 - E_trial) / (-0.5 * slope);
-      if (std::abs(rho - 1.0) > o.nonlinearity_tolerance) {
+      if (std::abs(rho - 1.0) > nonlinearity_tolerance) {
         ++planned;
         ++rep.iterations_for_nonlinearity;
       }

@@ -101,6 +101,7 @@ objects:
   EXPECT_EQ(o.shape.voxel_size, 0.005);
   EXPECT_EQ(s.solver.dt, 1.0 / 60);
   EXPECT_EQ(s.solver.gravity, Vec3(0, -9.81, 0));
+  EXPECT_FALSE(s.solver.nonlinearity_tolerance.has_value());  // auto
   EXPECT_EQ(s.output.out, "result.h5");
   EXPECT_TRUE(s.contact.all_pairs);
   EXPECT_NE(o.shape.location.find("s.yaml:8: objects[0].shape"), std::string::npos) << o.shape.location;
@@ -487,6 +488,26 @@ void expect_same_non_default(const RigidObjectDescription& a, const RigidObjectD
   }
   EXPECT_EQ(a.velocity, b.velocity);
   EXPECT_EQ(a.angular_velocity, b.angular_velocity);
+}
+
+/// solver.nonlinearity_tolerance: "auto" (or absent) leaves it unset, a number sets it, and an
+/// unset one is written as "auto" and read back unset.
+TEST(SceneDescription, NonlinearityToleranceIsAutoOrANumber) {
+  SceneFolder folder;
+  const std::string body = "bodies:\n  - name: a\n    avatar: avatar.h5\n";
+  const SceneDescription a =
+      parse_scene_description(body + "solver: {seconds: 1, nonlinearity_tolerance: auto}\n", folder.file("a.yaml"));
+  EXPECT_FALSE(a.solver.nonlinearity_tolerance.has_value());
+  const SceneDescription n =
+      parse_scene_description(body + "solver: {seconds: 1, nonlinearity_tolerance: 0.125}\n", folder.file("n.yaml"));
+  EXPECT_EQ(n.solver.nonlinearity_tolerance, 0.125);
+  write_scene_description(a, folder.file("auto.yaml"));
+  std::ifstream f(folder.file("auto.yaml"));
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("nonlinearity_tolerance: auto"), std::string::npos) << text;
+  EXPECT_FALSE(read_scene_description(folder.file("auto.yaml")).solver.nonlinearity_tolerance.has_value());
+  expect_scene_error(body + "solver: {seconds: 1, nonlinearity_tolerance: sometimes}\n",
+                     {"scene.yaml:4:", "solver.nonlinearity_tolerance"});
 }
 
 TEST(SceneDescription, FullRoundTripKeepsEveryField) {

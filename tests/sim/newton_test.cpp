@@ -189,6 +189,7 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
   Simulator sim(avatar_model(a, o));
   SimulatorOptions one = o;
   one.newton = NewtonOptions();
+  one.newton.nonlinearity_tolerance = 0.0;  // exactly one Newton step (the check is tested below)
   Simulator sim1(avatar_model(a, one));
   for (int i = 1; i <= 10; ++i) {
     const auto target = test::synthetic_motion(*a, i * o.h, 0.03, 0.5);
@@ -258,6 +259,37 @@ TEST(Newton, AFullStepFarFromItsQuadraticModelGetsOneMoreIteration) {
   }
   o.nonlinearity_tolerance = -1;
   EXPECT_THROW(newton_minimize({&term}, ctx, q, o), Error);
+}
+
+/// Unset, the tolerance is kAutoNonlinearityTolerance (0.05) when the step's DoFs are all soft
+/// tissue, and off when the system has others (here a dynamic bone, on which the quartic does
+/// not act: its zero Hessian rows are set to 1, so it does not move). Same quartic as above, ρ = 0.9.
+TEST(Newton, TheNonlinearityCheckIsOnByDefaultOnlyWhenEveryDofIsSoftTissue) {
+  QuarticTerm term;
+  term.b = 0.2;
+  NewtonOptions o;
+  o.max_z_step = 0;
+  ASSERT_FALSE(o.nonlinearity_tolerance.has_value());
+  EXPECT_EQ(kAutoNonlinearityTolerance, 0.05);
+  for (const bool bones_dynamic : {false, true}) {
+    StepContext ctx;
+    ctx.layout.bones_dynamic = bones_dynamic;
+    ctx.layout.num_bones = 1;
+    ctx.layout.num_reduced = 3;
+    Configuration q;
+    q.bones = {Isometry::Identity()};
+    q.z = VecX::Zero(3);
+    const StepReport rep = newton_minimize({&term}, ctx, q, o);
+    EXPECT_EQ(rep.iterations_for_nonlinearity, bones_dynamic ? 0 : 1) << "bones dynamic " << bones_dynamic;
+    EXPECT_NEAR(q.z[0], bones_dynamic ? 1.0 : 0.875, 1e-15);
+    EXPECT_TRUE(q.bones[0].isApprox(Isometry::Identity(), 0.0));
+    // Set explicitly, it applies with the bone too.
+    NewtonOptions explicit_tol = o;
+    explicit_tol.nonlinearity_tolerance = 0.05;
+    q.bones = {Isometry::Identity()};
+    q.z = VecX::Zero(3);
+    EXPECT_EQ(newton_minimize({&term}, ctx, q, explicit_tol).iterations_for_nonlinearity, 1);
+  }
 }
 
 }  // namespace

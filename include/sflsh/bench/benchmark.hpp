@@ -30,8 +30,8 @@ struct BenchOptions {
   double seconds = 0;                     ///< 0: 0.5 s quick, 2 s full
   std::string model = "procedural";
   VecX betas;
-  std::vector<int> handle_counts;         ///< empty: quick {16, 64}, full {16, 32, 64, 128}
-  int default_handles = 64;
+  std::vector<int> handle_counts;         ///< empty: quick {16, default}, full {16, 32, 64, 128}; the default K is added
+  int default_handles = PrecomputeOptions().handles;
   double default_dt = 1.0 / 60.0;
   int converged_newton_iters = 20;        ///< the "Newton to convergence" variant
   PrecomputeOptions precompute;           ///< template/shape options (cache dir, ...)

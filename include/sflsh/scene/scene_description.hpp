@@ -19,9 +19,10 @@
 //     newton_iters: 1           # Newton iterations per step, 1..100; default 1
 //     iterations_after_damping: 3  # more iterations while the last one is damped by a cap, 0..100; default 3
 //     line_search: false        # backtracking line search; default false
-//     nonlinearity_tolerance: 0 # one more Newton iteration where a full step's energy change is
-//                               # off its quadratic model by more than this share (|rho - 1|;
-//                               # 0.05 suits prescribed bones), >= 0; default 0 = off
+//     nonlinearity_tolerance: auto # one more Newton iteration where a full step's energy change
+//                               # is off its quadratic model by more than this share (|rho - 1|),
+//                               # >= 0 (0 = off); default auto: 0.05 when every body's bones are
+//                               # prescribed and there is no rigid body or tool, else off
 //     gravity: [0, -9.81, 0]    # m/s^2, world, Y up; default [0, -9.81, 0]
 //     damping: 0                # stiffness-proportional soft-tissue damping (s, >= 0); default 0
 //   output:                     # paths relative to the working folder (like the CLI flags)
@@ -116,6 +117,7 @@
 // motion, material or mesh files that do not exist. Whether a mesh is closed
 // is checked by validate_scene_files (it reads the meshes) and again when a
 // mesh is baked.
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -264,7 +266,7 @@ struct SolverDescription {
   int newton_iterations = 1;
   int iterations_after_damping = NewtonOptions{}.iterations_after_damping;  ///< NewtonOptions'
   bool line_search = false;
-  double nonlinearity_tolerance = NewtonOptions{}.nonlinearity_tolerance;  ///< NewtonOptions'
+  std::optional<double> nonlinearity_tolerance;  ///< NewtonOptions'; unset = auto
   Vec3 gravity = Vec3(0, -9.81, 0);     ///< m/s²
   double damping = 0;                   ///< s
 };
