@@ -1,10 +1,10 @@
 // `sflsh simulate`: drive an avatar with a motion, write the result cache,
 // optional exports and a picture.
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"

@@ -3,13 +3,13 @@
 #include <malloc.h>
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "sflsh/bench/bullet_peer.hpp"
@@ -362,7 +362,8 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
                    0.5);
   };
   const int K = o.default_handles;
-  // Handle counts at the default time step and cubature, one Newton step.
+  // Handle counts at the default time step and cubature, one Newton step
+  // (plus the automatic second where a step is far off its quadratic model).
   for (size_t i = 0; i < avatars.size(); ++i)
     reduced(avatars[i], o.handle_counts[i], h, 1,
             o.handle_counts[i] != K ? "" : K == PrecomputeOptions().handles ? "default" : "default settings otherwise",

@@ -22,7 +22,7 @@
 //     nonlinearity_tolerance: auto # one more Newton iteration where a full step's energy change
 //                               # is off its quadratic model by more than this share (|rho - 1|),
 //                               # >= 0 (0 = off); default auto: 0.05 when every body's bones are
-//                               # prescribed and there is no rigid body or tool, else off
+//                               # prescribed and no dynamic rigid object or tool, else off
 //     gravity: [0, -9.81, 0]    # m/s^2, world, Y up; default [0, -9.81, 0]
 //     damping: 0                # stiffness-proportional soft-tissue damping (s, >= 0); default 0
 //   output:                     # paths relative to the working folder (like the CLI flags)

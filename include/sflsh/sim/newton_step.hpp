@@ -57,7 +57,7 @@ struct NewtonOptions {
   /// nothing) and exceeds 0.05 on about a quarter of the steps of `shake` and
   /// a CMU run. 0 = off.
   /// Unset (the default): kAutoNonlinearityTolerance when every DoF of the
-  /// step is soft tissue (bones prescribed, no rigid body or tool), off
+  /// step is soft tissue (bones prescribed, no dynamic rigid object or tool), off
   /// otherwise: dynamic bones' rotations make ρ depart from 1 on most steps of
   /// any motion (|ρ − 1| > 0.1 on 56 % of `jump`'s, and as often for the soft
   /// DoFs' share of the step alone), so the check would double those steps.
