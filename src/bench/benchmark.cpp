@@ -410,8 +410,9 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
   // Handle allocation (issue 13's "handle placement"): more handles for the
   // small regions (calf, arms, neck, chest) at the same K, taken from the
   // large ones by the same apportionment.
-  for (int m : {4, 6}) {
-    const std::string what = "at least " + std::to_string(m) + " handles per region";
+  for (int m : {2, 4, 6}) {
+    const std::string what =
+        "at least " + std::to_string(m) + " handles per region" + (m == 2 ? " (before session 12)" : "");
     if (m == o.precompute.placement.min_per_region || !wanted(what)) continue;
     PrecomputeOptions po = o.precompute;
     po.handles = K;

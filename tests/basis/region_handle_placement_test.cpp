@@ -121,8 +121,12 @@ TEST(RegionHandlePlacement, EveryRegionGetsHandlesAndSoftWeight) {
   const test::LimbedBody b;
   const VecXi node_region = node_regions_from_tets(b.mesh, b.tet_region, 3);
   const int K = 12;
-  const HandleSet hs = select_handles(b.mesh, b.role, K, b.thickness, node_region);
-  EXPECT_EQ(hs.nodes, select_handles(b.mesh, b.role, K, b.thickness, node_region).nodes);  // deterministic
+  // A minimum of 2 per region (the default until session 12; 4 of 12 handles
+  // in each of 3 regions would leave the allocation nothing to decide).
+  HandlePlacementOptions two;
+  two.min_per_region = 2;
+  const HandleSet hs = select_handles(b.mesh, b.role, K, b.thickness, node_region, two);
+  EXPECT_EQ(hs.nodes, select_handles(b.mesh, b.role, K, b.thickness, node_region, two).nodes);  // deterministic
   std::set<int> unique(hs.nodes.data(), hs.nodes.data() + K);
   EXPECT_EQ(int(unique.size()), K);
   for (int k = 0; k < K; ++k) EXPECT_EQ(b.role[hs.nodes[k]], int(NodeRole::Simulated));

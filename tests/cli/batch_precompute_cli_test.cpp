@@ -226,9 +226,11 @@ TEST_F(BatchCli, DaskLocalClusterOfTwoWorkersBuildsEveryRow) {
   }
 }
 
-/// `--handles-min-per-region`: every region the default gives its minimum of 2
+/// `--handles-min-per-region`: every region that a minimum of 2 leaves at 2
 /// handles gets at least 3 with the flag at 3, from the same K (taken from the
-/// large regions), and the batch content key tells the two settings apart.
+/// large regions), and the batch content key tells the settings apart (also
+/// the default, 4, from 2: the default until session 12, whose keys did not
+/// spell the minimum out).
 TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
   const std::string coarse = " --cell-size 0.08 --facet-size 0.06 --facet-distance 0.004 --cache-dir " +
                              dir_->file("cache") + " --handles 40";
@@ -245,7 +247,7 @@ TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
     for (int node : basis::nearest_nodes(a.tet.nodes, a.handles)) ++n[size_t(node_region[node])];
     return n;
   };
-  const std::vector<int> two = counts("", "min2.h5"), three = counts(" --handles-min-per-region 3", "min3.h5");
+  const std::vector<int> two = counts(" --handles-min-per-region 2", "min2.h5"), three = counts(" --handles-min-per-region 3", "min3.h5");
   int at_two = 0;
   for (size_t r = 0; r < two.size(); ++r) {
     if (two[r] == 2) ++at_two;
@@ -254,8 +256,12 @@ TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
   EXPECT_GT(at_two, 0) << "no region at the default minimum: the test would not see the flag";
   EXPECT_EQ(std::accumulate(two.begin(), two.end(), 0), 40);
   EXPECT_EQ(std::accumulate(three.begin(), three.end(), 0), 40);
-  PrecomputeOptions o2, o3;
+  PrecomputeOptions o2, o3, o4;
+  o2.placement.min_per_region = 2;
   o3.placement.min_per_region = 3;
+  EXPECT_EQ(o4.placement.min_per_region, 4);
   const BodyModel model = load_body_model("procedural");
-  EXPECT_NE(avatar_content_key(model, VecX::Zero(10), o2), avatar_content_key(model, VecX::Zero(10), o3));
+  const VecX b = VecX::Zero(10);
+  EXPECT_NE(avatar_content_key(model, b, o2), avatar_content_key(model, b, o3));
+  EXPECT_NE(avatar_content_key(model, b, o2), avatar_content_key(model, b, o4));
 }

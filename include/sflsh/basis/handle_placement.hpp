@@ -45,7 +45,10 @@ struct HandlePlacementOptions {
   /// minimum, or a region has fewer nodes). Smaller regions — e.g. the few
   /// Simulated nodes whose tets are labelled head or foot at the border of a
   /// skinned part — get handles only in proportion to their weight.
-  int min_per_region = 2;
+  /// 4 since issue 13's session 12 (2 before): at K = 96 it lowers rel_err
+  /// on all four bench motions (mean 0.242 → 0.234) and the arms' and neck's
+  /// by 10–25 % (scripts/results/handle_count_and_allocation.md).
+  int min_per_region = 4;
   double min_region_fraction = 0.01;
   /// The distance to the nearest Dirichlet node counts this many times in the
   /// sampling metric (min over handles and Dirichlet nodes). > 1 keeps thin
