@@ -492,7 +492,12 @@ SolverDescription parse_solver(const SceneParser& p, const YAML::Node& n) {
     s.iterations_after_damping = p.integer(v, "solver.iterations_after_damping", 0, 100);
   if (const auto v = n["line_search"]) s.line_search = p.boolean(v, "solver.line_search");
   if (const auto v = n["nonlinearity_tolerance"]) {
-    if (!(v.IsScalar() && v.Scalar() == "auto")) s.nonlinearity_tolerance = p.non_negative(v, "solver.nonlinearity_tolerance");
+    if (!(v.IsScalar() && v.Scalar() == "auto")) {
+      const double t = p.convert<double>(v, "solver.nonlinearity_tolerance", "auto or a number >= 0");
+      if (!(std::isfinite(t) && t >= 0))
+        p.error(v, "solver.nonlinearity_tolerance", "expected auto or a number >= 0, got ", v.Scalar());
+      s.nonlinearity_tolerance = t;
+    }
   }
   if (const auto v = n["gravity"]) s.gravity = p.vec3(v, "solver.gravity");
   if (const auto v = n["damping"]) s.damping = p.non_negative(v, "solver.damping");

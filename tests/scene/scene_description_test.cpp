@@ -507,7 +507,9 @@ TEST(SceneDescription, NonlinearityToleranceIsAutoOrANumber) {
   EXPECT_NE(text.find("nonlinearity_tolerance: auto"), std::string::npos) << text;
   EXPECT_FALSE(read_scene_description(folder.file("auto.yaml")).solver.nonlinearity_tolerance.has_value());
   expect_scene_error(body + "solver: {seconds: 1, nonlinearity_tolerance: sometimes}\n",
-                     {"scene.yaml:4:", "solver.nonlinearity_tolerance"});
+                     {"scene.yaml:4:", "solver.nonlinearity_tolerance", "auto or a number >= 0", "sometimes"});
+  expect_scene_error(body + "solver: {seconds: 1, nonlinearity_tolerance: -0.5}\n",
+                     {"scene.yaml:4:", "solver.nonlinearity_tolerance", "auto or a number >= 0", "-0.5"});
 }
 
 TEST(SceneDescription, FullRoundTripKeepsEveryField) {
