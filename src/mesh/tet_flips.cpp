@@ -119,6 +119,23 @@ struct FlipMesh {
   }
 };
 
+/// The frame of both flip passes: up to `rounds` sweeps over the tets alive
+/// when each sweep starts; every live one rated below `target_deg` is offered
+/// to `try_flip(t)` (true when it flipped t away), until a sweep flips
+/// nothing. Then the live tets are written back to `mesh`.
+template <class TryFlip>
+void sweep_bad_tets(TetMesh& mesh, FlipMesh& m, double target_deg, int rounds, std::vector<int>* parent,
+                    TryFlip try_flip) {
+  for (int round = 0; round < rounds; ++round) {
+    int made = 0;
+    const size_t count = m.tets.size();
+    for (size_t t = 0; t < count; ++t)
+      if (m.alive[t] && !(quality(mesh.nodes, m.tets[t]).min_dihedral_deg >= target_deg)) made += try_flip(t);
+    if (made == 0) break;
+  }
+  m.finish(mesh, parent);
+}
+
 }  // namespace
 
 TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
@@ -132,11 +149,7 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
   const Points& x = mesh.nodes;
   auto rate = [&](int t) { return quality(x, tets[t]).min_dihedral_deg; };
 
-  for (int round = 0; round < rounds; ++round) {
-    int made = 0;
-    const size_t count = tets.size();
-    for (size_t t = 0; t < count; ++t) {
-      if (!m.alive[t] || rate(int(t)) >= target_deg) continue;
+  sweep_bad_tets(mesh, m, target_deg, rounds, parent, [&](size_t t) {
       bool done = false;
       // 2-3 across each interior face.
       for (int i = 0; i < 4 && !done; ++i) {
@@ -190,11 +203,8 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
             done = true;
           }
         }
-      made += done;
-    }
-    if (made == 0) break;
-  }
-  m.finish(mesh, parent);
+      return done;
+  });
   rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
   return rep;
 }
@@ -209,11 +219,7 @@ TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on
   const Points& x = mesh.nodes;
   auto rate = [&](int t) { return quality(x, m.tets[t]).min_dihedral_deg; };
   auto point = [&](int n) -> Vec3 { return x.row(n).transpose(); };
-  for (int round = 0; round < rounds; ++round) {
-    int made = 0;
-    const size_t count = m.tets.size();
-    for (size_t t = 0; t < count; ++t) {
-      if (!m.alive[t] || rate(int(t)) >= target_deg) continue;
+  sweep_bad_tets(mesh, m, target_deg, rounds, parent, [&](size_t t) {
       bool done = false;
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j) {
@@ -248,11 +254,8 @@ TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on
           ++rep.flips_2_2;
           done = true;
         }
-      made += done;
-    }
-    if (made == 0) break;
-  }
-  m.finish(mesh, parent);
+      return done;
+  });
   rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
   return rep;
 }
