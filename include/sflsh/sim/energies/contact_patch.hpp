@@ -1,0 +1,127 @@
+#pragma once
+// Rigid ↔ flesh contact that dents (DESIGN.md §7): contact sampled over the
+// skin's faces with a pressure stiffness (skin_face_samples.hpp), and a
+// full-space patch under the contact.
+//
+// The reduced basis is global and smooth: a 2 cm probe needs a dent a few
+// centimetres wide, which the handles cannot form, so a pure subspace carries
+// the load through penetration and its force is several times the full FEM's.
+// Here the tet nodes within `patch_radius` (unposed) of the skin near the
+// object get their own displacement δu on top of the subspace,
+//   u_n = W_n z + δu_n   (unposed, m),   δu = 0 outside the patch,
+// and the step's energy gains the exact change that δu brings:
+//   Φ(q, δu) = Σ_{t ∈ patch tets} V_t [Ψ(F_t(Wz + δu)) − Ψ(F_t(Wz))]            (elasticity)
+//            + Σ_{n ∈ patch} m_n/(2h²) (|r_n + e_n|² − |r_n|²) − m_n g·d_n           (inertia, gravity)
+//            + Σ_s ½ κ a_s min(φ(x_s), 0)²                                          (contact)
+// with d_n = A_n δu_n the node's world offset (A_n = Σ_j w_nj R_j), r_n = x_n(q)
+// − x*_n the subspace node's inertial residual, e_n = d_n − (2 d_n(t) − d_n(t−h))
+// (δu carries its own velocity while the patch persists), and x_s = Σ_i λ_i
+// (x_{v_i}(q) + A_{v_i} Σ_c b_{v_i c} δu_{n_c}) a face sample over the skin
+// vertices v_i embedded in their tets (surface_tet, surface_bary). Without δu
+// every term but the contact vanishes: the patch only refines.
+//
+// Condensation (Teng et al. 2015, "Subspace condensation"): the term's energy
+// is E(q) = min_δu Φ(q, δu), the patch minimized out at every evaluation
+// (Newton on δu with q fixed: a small dense system, a few iterations). Then
+// ∂E/∂q = ∂Φ/∂q at the minimizer (envelope theorem) and the Hessian is the
+// Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq, so the global step stays one
+// Newton step over bones and handles. Approximations, all in the Hessian
+// only: Gauss–Newton for the contact, the element Hessians PSD-projected, the
+// change of the subspace's own elastic Hessian in the patch (K(Wz + δu) −
+// K(Wz), zero for a quadratic energy) left out, and A_n held at the iterate's
+// bones (δu's rotation with the bones is not differentiated).
+//
+// Limit: with the patch covering every Simulated node, the elastic cubature
+// exact per tet and the inertia lumped at the nodes, E(q) is the full FEM's
+// energy of u = Wz + δu minimized over δu: the step is the full-FEM step.
+//
+// Life of a patch: begin_step selects the candidate faces (a vertex within
+// reach of the object at time t) and the patch nodes (Simulated nodes within
+// patch_radius of a near vertex, plus every node whose δu is still above
+// release_displacement: a patch stays until its dent has relaxed, so it
+// releases without a pop). The displacement at t + h is the minimizer at the
+// step's final q, fixed when the integrator asks for the report.
+//
+// Objects: static or kinematic (a named world frame of the step inputs).
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sflsh/geometry/sdf.hpp"
+#include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/material.hpp"
+#include "sflsh/sim/posed_points.hpp"
+#include "sflsh/sim/skin_face_samples.hpp"
+#include "sflsh/sim/step_report.hpp"
+
+namespace sflsh {
+
+struct ContactPatchOptions {
+  double pressure_stiffness = kDefaultPressureStiffness;  ///< κ, N/m³
+  double spacing = kDefaultContactSpacing;                ///< m, face sample spacing
+  /// The full-space patch (false: contact on the subspace alone, sampled the same way).
+  bool patch = true;
+  /// m (unposed, > 0): Simulated nodes this close to a skin vertex near the
+  /// object get a full-space displacement.
+  double patch_radius = 0.04;
+  /// m: a skin vertex is near the object when φ at time t is below this plus
+  /// its motion and the object's over the step.
+  double margin = 0.005;
+  int max_inner_iterations = 30;       ///< Newton iterations on δu per evaluation
+  double inner_tolerance = 1e-10;      ///< relative decrease of ‖∂Φ/∂δu‖ that ends them
+  double release_displacement = 1e-6;  ///< m: a node leaves the patch once |δu| is below this
+  int max_handles = 8;                 ///< basis row truncation of the skin vertices (sdf_contact.hpp)
+};
+
+class ContactPatchTerm : public EnergyTerm {
+ public:
+  /// `field` in the object's shape frame, placed by the world frame `object`
+  /// of the step inputs times `shape_in_frame`. Throws on bad options (one line).
+  ContactPatchTerm(std::string object, const Avatar& avatar, geometry::SdfPtr field, const Isometry& shape_in_frame,
+                   const ContactPatchOptions& options = {});
+  std::string name() const override { return "contact:" + object_; }
+  std::unique_ptr<TermCache> make_cache() const override;
+  void begin_step(const StepContext& ctx) const override;
+  bool active(const StepContext& ctx) const override;
+  double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
+  /// "force" (3, N, what the object exerts on the body, world), "active_samples",
+  /// "max_penetration" (m), "contact_area" (m²), "patch_nodes", "max_patch_displacement" (m),
+  /// "patch_displacement" (4 per patch node: the node's index, then its δu, m, unposed);
+  /// also fixes the patch displacement of the step (header comment).
+  std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
+
+  const ContactPatchOptions& options() const { return options_; }
+  /// Patch nodes of the current step (after begin_step).
+  std::vector<int> patch_nodes(const StepContext& ctx) const;
+
+  struct Evaluation;  // one evaluation of Φ and its derivatives (contact_patch.cpp)
+
+ private:
+  double evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, bool q_derivatives,
+                  Evaluation& out) const;
+  /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
+  VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
+
+  std::string object_;
+  const Avatar* avatar_;
+  geometry::SdfPtr field_;
+  Isometry shape_in_frame_;
+  ContactPatchOptions options_;
+  PosedPoints vertices_;  // skin vertices (subspace), rows truncated
+  PosedPoints nodes_;     // tet nodes (subspace)
+  VecX node_mass_;        // lumped, kg
+  std::vector<Eigen::Matrix<double, 4, 3>> grads_;  // per tet shape gradients
+  VecX tet_volume_;
+  std::vector<MaterialPoint> materials_;
+  std::vector<std::vector<int>> node_tets_;    // tets of each node
+  std::vector<std::vector<int>> vertex_faces_;  // skin faces of each vertex
+};
+
+/// #V by 3 soft displacement (m, unposed) that the patches of `report` add
+/// to the skin vertices: each vertex takes its tet's nodes' δu (quantities
+/// "patch_displacement" of every term of body `body`), barycentrically.
+/// Zero where no patch is.
+Points patch_surface_displacement(const Avatar& avatar, const StepReport& report, int body = 0);
+
+}  // namespace sflsh

@@ -1,0 +1,560 @@
+#include "sflsh/sim/energies/contact_patch.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <tuple>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
+#include "sflsh/fem/tet_operators.hpp"
+#include "sflsh/sim/energies/elastic.hpp"
+
+namespace sflsh {
+
+/// Φ and its derivatives at one (q, δu) (header comment): over the patch DoFs p
+/// (3 per patch node, cache order) and the term's local layout q.
+struct ContactPatchTerm::Evaluation {
+  double energy = 0;
+  VecX gp;   // ∂Φ/∂δu
+  MatX Hpp;  // its PSD approximation
+  VecX gq;   // ∂Φ/∂q
+  MatX Hqq;  // Gauss–Newton contact block
+  MatX Hqp;  // cross block (layout rows by patch DoFs)
+  Vec3 force = Vec3::Zero();
+  int active = 0;
+  double depth = 0, area = 0;
+};
+
+namespace {
+
+struct PatchHistory {
+  Vec3 du = Vec3::Zero();       // unposed displacement at t (warm start)
+  Vec3 d_t = Vec3::Zero();      // world offset A δu at t
+  Vec3 d_prev = Vec3::Zero();   // at t − h
+  Vec3 du_next = Vec3::Zero();  // fixed by report() for t + h
+  Vec3 d_next = Vec3::Zero();
+};
+
+struct PatchCache : TermCache {
+  Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h
+  std::vector<int> faces;                      // candidate skin faces
+  std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
+  std::vector<int> face_first;                 // samples of faces[i]: [face_first[i], face_first[i+1])
+  std::vector<int> vertices;                   // distinct vertices of the candidate faces
+  std::unordered_map<int, int> vertex_slot;    // vertex → index into `vertices`
+  std::vector<int> nodes;                      // patch nodes
+  std::unordered_map<int, int> node_slot;      // node → index into `nodes`
+  std::vector<int> tets;                       // tets with a patch node
+  std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
+  VecX du;                                     // last minimizer (3 per patch node)
+  std::unordered_map<int, PatchHistory> history;
+};
+
+PatchCache& patch_cache(const StepContext& ctx, const std::string& name) {
+  require(ctx.cache != nullptr, name, ": no cache (call begin_step through begin_term_step or the integrator)");
+  return static_cast<PatchCache&>(*ctx.cache);
+}
+
+const DofLayout& local_layout(const StepContext& ctx) { return ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout; }
+
+/// Σ_j w_j R_j over the non-zero entries of a row of skinning weights.
+template <class Row>
+Mat3 blend_rotation(const Row& w, const std::vector<Isometry>& bones) {
+  Mat3 A = Mat3::Zero();
+  for (int j = 0; j < w.size(); ++j)
+    if (w[j] != 0.0) A += w[j] * bones[j].linear();
+  return A;
+}
+
+/// Adds the generalized force of a world force `f` on an offset d = Σ_j w_j R_j o
+/// (o unposed) to the bones' rotations: ∂d/∂ω_j = −[w_j R_j o]×, so bone j's
+/// ω gains (w_j R_j o) × f (translations do not move an offset).
+template <class Row>
+void add_offset_rotation_gradient(const Row& w, const std::vector<Isometry>& bones, const Vec3& o, const Vec3& f,
+                                  const DofLayout& L, VecX& gq) {
+  if (!L.bones_dynamic) return;
+  for (int j = 0; j < w.size(); ++j)
+    if (w[j] != 0.0) gq.segment<3>(L.bone_offset(j)) += (w[j] * (bones[j].linear() * o)).cross(f);
+}
+
+}  // namespace
+
+ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry::SdfPtr field,
+                                   const Isometry& shape_in_frame, const ContactPatchOptions& o)
+    : object_(std::move(object)), avatar_(&a), field_(std::move(field)), shape_in_frame_(shape_in_frame), options_(o) {
+  const std::string what = "contact with '" + object_ + "'";
+  require(field_ != nullptr, what, ": no field");
+  check_contact_sampling(o.pressure_stiffness, o.spacing, what);
+  require(std::isfinite(o.patch_radius) && o.patch_radius > 0, what, ": patch radius ", o.patch_radius,
+          " m, expected a finite number > 0");
+  require(std::isfinite(o.margin) && o.margin >= 0, what, ": margin ", o.margin, " m, expected >= 0");
+  require(o.max_inner_iterations >= 1 && o.inner_tolerance >= 0 && o.release_displacement >= 0, what,
+          ": inner iterations must be >= 1 and the tolerances >= 0");
+  vertices_ = PosedPoints::at_surface(a);
+  if (o.max_handles > 0) vertices_ = vertices_.with_truncated_rows(o.max_handles);
+  const int N = a.tet.num_nodes(), T = a.tet.num_elements();
+  node_tets_.assign(N, {});
+  for (int t = 0; t < T; ++t)
+    for (int c = 0; c < 4; ++c) node_tets_[a.tet.elements(t, c)].push_back(t);
+  // The subspace at the nodes: each node as a point of one of its tets.
+  Cubature at_nodes;
+  at_nodes.elements.resize(N);
+  at_nodes.barycentric = MatXr::Zero(N, 4);
+  at_nodes.weights = VecX::Ones(N);
+  for (int n = 0; n < N; ++n) {
+    require(!node_tets_[n].empty(), what, ": tet node ", n, " belongs to no tet");
+    const int t = node_tets_[n][0];
+    at_nodes.elements[n] = t;
+    for (int c = 0; c < 4; ++c)
+      if (a.tet.elements(t, c) == n) at_nodes.barycentric(n, c) = 1.0;
+  }
+  nodes_ = PosedPoints::at_cubature(a, at_nodes);
+  grads_ = fem::tet_gradients(a.tet);
+  tet_volume_.resize(T);
+  node_mass_ = VecX::Zero(N);
+  materials_.reserve(T);
+  for (int t = 0; t < T; ++t) {
+    Mat3 D;
+    for (int c = 1; c < 4; ++c)
+      D.col(c - 1) = (a.tet.nodes.row(a.tet.elements(t, c)) - a.tet.nodes.row(a.tet.elements(t, 0))).transpose();
+    tet_volume_[t] = D.determinant() / 6.0;
+    const RegionMaterial& m = tet_material(a, t);
+    materials_.emplace_back(m, tet_frame(a, t));
+    for (int c = 0; c < 4; ++c) node_mass_[a.tet.elements(t, c)] += m.density * tet_volume_[t] / 4.0;
+  }
+  vertex_faces_.assign(a.surface_rest.rows(), {});
+  for (int f = 0; f < a.surface_faces.rows(); ++f)
+    for (int i = 0; i < 3; ++i) vertex_faces_[a.surface_faces(f, i)].push_back(f);
+}
+
+std::unique_ptr<TermCache> ContactPatchTerm::make_cache() const { return std::make_unique<PatchCache>(); }
+
+std::vector<int> ContactPatchTerm::patch_nodes(const StepContext& ctx) const { return patch_cache(ctx, name()).nodes; }
+
+void ContactPatchTerm::begin_step(const StepContext& ctx) const {
+  PatchCache& c = patch_cache(ctx, name());
+  const Avatar& a = *avatar_;
+  // The displacement fixed at the end of the last step becomes the one at t.
+  for (auto it = c.history.begin(); it != c.history.end();) {
+    PatchHistory& h = it->second;
+    h.d_prev = h.d_t;
+    h.d_t = h.d_next;
+    h.du = h.du_next;
+    const double rel = options_.release_displacement;
+    if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel)
+      it = c.history.erase(it);
+    else
+      ++it;
+  }
+  require(ctx.frames != nullptr, name(), ": the step has no world frames");
+  const auto fr = ctx.frames->find(object_);
+  require(fr != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
+  const WorldFrame& f = fr->second;
+  require(f.pose.matrix().allFinite(), name(), ": world frame '", object_, "' is not finite");
+  c.field_pose = f.pose * shape_in_frame_;
+  const Isometry T_inv = c.field_pose.inverse();
+  const geometry::Aabb local = field_->bounds();
+  const bool bounded = !local.is_unbounded();
+  const double extent = bounded ? 0.5 * (local.max - local.min).norm() : 1.0;
+  const double object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
+  const geometry::Aabb box = bounded ? local.transformed(c.field_pose) : local;
+
+  // Skin vertices near the object at time t.
+  const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
+                                         : ctx.bound[0];
+  const Configuration& qt = *b.q_prev;
+  const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
+  std::vector<int> near;
+  for (int v = 0; v < vertices_.size(); ++v) {
+    const Vec3 x = vertices_.world_point(v, qt);
+    const double motion = has_prev ? 2 * (x - vertices_.world_point(v, *b.q_prev2)).norm() : 0.0;
+    const double reach = options_.margin + motion + object_motion;
+    if (bounded) {
+      const Vec3 lo = box.min.array() - reach, hi = box.max.array() + reach;
+      if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+    }
+    if (field_->distance(T_inv * x) < reach) near.push_back(v);
+  }
+  // Candidate faces and their samples.
+  std::vector<char> face_mark(a.surface_faces.rows(), 0);
+  c.faces.clear();
+  for (int v : near)
+    for (int fc : vertex_faces_[v])
+      if (!face_mark[fc]) face_mark[fc] = 1, c.faces.push_back(fc);
+  std::sort(c.faces.begin(), c.faces.end());
+  c.samples.clear();
+  c.face_first.assign(1, 0);
+  c.vertices.clear();
+  c.vertex_slot.clear();
+  for (int fc : c.faces) {
+    append_face_samples(a.surface_rest, a.surface_faces, fc, options_.spacing, c.samples);
+    c.face_first.push_back(int(c.samples.size()));
+    for (int i = 0; i < 3; ++i) {
+      const int v = a.surface_faces(fc, i);
+      if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
+    }
+  }
+  // Patch nodes: Simulated nodes within the radius of a near vertex (unposed),
+  // and every node still displaced.
+  c.nodes.clear();
+  c.node_slot.clear();
+  auto add_node = [&](int n) {
+    if (c.node_slot.emplace(n, int(c.nodes.size())).second) c.nodes.push_back(n);
+  };
+  if (options_.patch) {
+    const double r2 = options_.patch_radius * options_.patch_radius;
+    if (!near.empty()) {
+      // Bounding box of the near vertices first: most nodes are far.
+      Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+      for (int v : near) {
+        lo = lo.cwiseMin(Vec3(a.surface_rest.row(v).transpose()));
+        hi = hi.cwiseMax(Vec3(a.surface_rest.row(v).transpose()));
+      }
+      lo.array() -= options_.patch_radius;
+      hi.array() += options_.patch_radius;
+      for (int n = 0; n < a.tet.num_nodes(); ++n) {
+        if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+        const Vec3 y = a.tet.nodes.row(n).transpose();
+        if ((y.array() < lo.array()).any() || (y.array() > hi.array()).any()) continue;
+        for (int v : near)
+          if ((y - a.surface_rest.row(v).transpose()).squaredNorm() <= r2) {
+            add_node(n);
+            break;
+          }
+      }
+    }
+    for (const auto& [n, h] : c.history) add_node(n);
+  }
+  std::sort(c.nodes.begin(), c.nodes.end());
+  c.node_slot.clear();
+  for (int i = 0; i < int(c.nodes.size()); ++i) c.node_slot[c.nodes[i]] = i;
+  std::vector<char> tet_mark(a.tet.num_elements(), 0);
+  c.tets.clear();
+  for (int n : c.nodes)
+    for (int t : node_tets_[n])
+      if (!tet_mark[t]) tet_mark[t] = 1, c.tets.push_back(t);
+  std::sort(c.tets.begin(), c.tets.end());
+  // Predictions and the warm start.
+  const size_t P = c.nodes.size();
+  c.x_star.assign(P, Vec3::Zero());
+  c.d_pred.assign(P, Vec3::Zero());
+  c.du = VecX::Zero(3 * P);
+  for (size_t i = 0; i < P; ++i) {
+    const int n = c.nodes[i];
+    const Vec3 xt = nodes_.world_point(n, qt);
+    c.x_star[i] = has_prev ? Vec3(2 * xt - nodes_.world_point(n, *b.q_prev2)) : xt;
+    const auto h = c.history.find(n);
+    if (h == c.history.end()) continue;
+    c.d_pred[i] = 2 * h->second.d_t - h->second.d_prev;
+    c.du.segment<3>(3 * i) = h->second.du;
+  }
+}
+
+bool ContactPatchTerm::active(const StepContext& ctx) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  return !c.faces.empty() || !c.nodes.empty();
+}
+
+double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, bool q_derivatives,
+                                  Evaluation& out) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  const Avatar& a = *avatar_;
+  const DofLayout& L = local_layout(ctx);
+  const int nq = L.size(), np = int(du.size()), z0 = L.z_offset();
+  const double inv_h2 = 1.0 / (ctx.h * ctx.h);
+  out = Evaluation();
+  out.gp = VecX::Zero(np);
+  out.Hpp = MatX::Zero(np, np);
+  if (q_derivatives) {
+    out.gq = VecX::Zero(nq);
+    out.Hqq = MatX::Zero(nq, nq);
+    out.Hqp = MatX::Zero(nq, np);
+  }
+  double E = 0;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  auto simulated = [&](int n) { return a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated); };
+
+  // Inertia and gravity of the patch's offsets.
+  std::vector<Mat3> A(c.nodes.size());
+  for (size_t i = 0; i < c.nodes.size(); ++i) {
+    const int n = c.nodes[i];
+    const double m = node_mass_[n];
+    A[i] = blend_rotation(a.node_weights.row(n), q.bones);
+    const Vec3 d = A[i] * du.segment<3>(3 * i);
+    const Vec3 e = d - c.d_pred[i];
+    const Vec3 r = nodes_.world_point(n, q) - c.x_star[i];
+    E += 0.5 * m * inv_h2 * (2 * r.dot(e) + e.squaredNorm()) - m * ctx.gravity.dot(d);
+    const Vec3 fd = m * inv_h2 * (r + e) - m * ctx.gravity;  // ∂Φ/∂d
+    out.gp.segment<3>(3 * i) += A[i].transpose() * fd;
+    out.Hpp.block<3, 3>(3 * i, 3 * i) += m * inv_h2 * A[i].transpose() * A[i];
+    if (!q_derivatives) continue;
+    add_offset_rotation_gradient(a.node_weights.row(n), q.bones, du.segment<3>(3 * i), fd, L, out.gq);
+    nodes_.local_jacobian(n, q, L, J, cols);
+    const Vec3 ge = m * inv_h2 * e;
+    const MatX JA = J.transpose() * (m * inv_h2 * A[i]);
+    for (size_t k = 0; k < cols.size(); ++k) {
+      out.gq[cols[k]] += J.col(k).dot(ge);
+      out.Hqp.block<1, 3>(cols[k], 3 * i) += JA.row(k);
+    }
+  }
+
+  // Elasticity: the exact change δu brings to each patch tet.
+  for (int t : c.tets) {
+    std::array<int, 4> slot;
+    Mat3 F0 = Mat3::Identity(), F1 = Mat3::Identity();
+    for (int k = 0; k < 4; ++k) {
+      const int n = a.tet.elements(t, k);
+      Vec3 us = Vec3::Zero();
+      if (simulated(n))
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
+          us += it.value() * q.z.segment<3>(3 * it.col());
+      const auto s = c.node_slot.find(n);
+      slot[k] = s == c.node_slot.end() ? -1 : s->second;
+      const Vec3 u1 = slot[k] >= 0 ? Vec3(us + du.segment<3>(3 * slot[k])) : us;
+      F0 += us * grads_[t].row(k);
+      F1 += u1 * grads_[t].row(k);
+    }
+    Mat3 P0, P1;
+    Mat9 H1;
+    const double psi1 = strain_energy_density(F1, materials_[t], &P1, &H1, true);
+    if (!std::isfinite(psi1)) return out.energy = std::numeric_limits<double>::infinity();
+    const double psi0 = strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, nullptr, false);
+    const double V = tet_volume_[t];
+    E += V * (psi1 - psi0);
+    // Element blocks K_kl (3x3) = V Σ_{b,l} ∇N_k[b] H1(i + 3b, j + 3l) ∇N_l[l].
+    std::array<std::array<Mat3, 4>, 4> K;
+    for (int k = 0; k < 4; ++k)
+      for (int l = 0; l < 4; ++l) {
+        const Vec3 gk = grads_[t].row(k).transpose(), gl = grads_[t].row(l).transpose();
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            double v = 0;
+            for (int bb = 0; bb < 3; ++bb)
+              for (int ll = 0; ll < 3; ++ll) v += gk[bb] * H1(i + 3 * bb, j + 3 * ll) * gl[ll];
+            K[k][l](i, j) = V * v;
+          }
+      }
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 gk = grads_[t].row(k).transpose();
+      if (slot[k] >= 0) {
+        out.gp.segment<3>(3 * slot[k]) += V * (P1 * gk);
+        for (int l = 0; l < 4; ++l)
+          if (slot[l] >= 0) out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
+      }
+      if (!q_derivatives) continue;
+      const int n = a.tet.elements(t, k);
+      if (!simulated(n)) continue;
+      const Vec3 dg = V * ((P1 - P0) * gk);
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
+        const int row = z0 + 3 * int(it.col());
+        out.gq.segment<3>(row) += it.value() * dg;
+        for (int l = 0; l < 4; ++l)
+          if (slot[l] >= 0) out.Hqp.block<3, 3>(row, 3 * slot[l]) += it.value() * K[k][l];
+      }
+    }
+  }
+
+  // Contact over the candidate faces' samples.
+  const Isometry& T = c.field_pose;
+  const Isometry T_inv = T.inverse();
+  const double kappa = options_.pressure_stiffness;
+  const size_t nv = c.vertices.size();
+  std::vector<Vec3> xv(nv);
+  std::vector<Mat3> Av(nv);
+  std::vector<Vec3> offset(nv);  // Σ_c b_c δu_c of each vertex (unposed)
+  // Patch coupling of each vertex: (patch slot, barycentric weight) over its tet's nodes.
+  std::vector<std::array<std::pair<int, double>, 4>> couple(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    const int v = c.vertices[i];
+    Av[i] = blend_rotation(a.surface_weights.row(v), q.bones);
+    Vec3 off = Vec3::Zero();
+    const int t = a.surface_tet[v];
+    for (int k = 0; k < 4; ++k) {
+      const auto s = c.node_slot.find(a.tet.elements(t, k));
+      couple[i][k] = {s == c.node_slot.end() ? -1 : s->second, a.surface_bary(v, k)};
+      if (couple[i][k].first >= 0) off += couple[i][k].second * du.segment<3>(3 * couple[i][k].first);
+    }
+    offset[i] = off;
+    xv[i] = vertices_.world_point(v, q) + Av[i] * off;
+  }
+  for (size_t fi = 0; fi < c.faces.size(); ++fi) {
+    const int fc = c.faces[fi];
+    std::array<int, 3> vs;
+    for (int i = 0; i < 3; ++i) vs[i] = c.vertex_slot.at(a.surface_faces(fc, i));
+    // Per face: g_i = Σ_s λ_i g_s and M_ij = Σ_s λ_i λ_j H_s over its touching samples.
+    std::array<Vec3, 3> g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    std::array<std::array<Mat3, 3>, 3> M;
+    for (auto& row : M) row.fill(Mat3::Zero());
+    bool touching = false;
+    for (int s = c.face_first[fi]; s < c.face_first[fi + 1]; ++s) {
+      const SkinFaceSample& smp = c.samples[s];
+      const Vec3 x = smp.lambda[0] * xv[vs[0]] + smp.lambda[1] * xv[vs[1]] + smp.lambda[2] * xv[vs[2]];
+      const geometry::SdfSample sd = field_->evaluate(T_inv * x);
+      if (!(sd.distance < 0)) continue;
+      touching = true;
+      const double k = kappa * smp.area, d = sd.distance;
+      const Vec3 nrm = T.linear() * sd.gradient;
+      E += 0.5 * k * d * d;
+      out.force -= k * d * nrm;
+      ++out.active;
+      out.depth = std::max(out.depth, -d);
+      out.area += smp.area;
+      const Mat3 H = k * nrm * nrm.transpose();
+      for (int i = 0; i < 3; ++i) {
+        g[i] += smp.lambda[i] * k * d * nrm;
+        for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
+      }
+    }
+    if (!touching) continue;
+    // Patch DoFs: ∂x_s/∂δu_c = λ_i b_ic A_i.
+    for (int i = 0; i < 3; ++i)
+      for (const auto& [pi, bi] : couple[vs[i]]) {
+        if (pi < 0 || bi == 0.0) continue;
+        const Mat3 Bi = bi * Av[vs[i]];
+        out.gp.segment<3>(3 * pi) += Bi.transpose() * g[i];
+        for (int j = 0; j < 3; ++j)
+          for (const auto& [pj, bj] : couple[vs[j]]) {
+            if (pj < 0 || bj == 0.0) continue;
+            out.Hpp.block<3, 3>(3 * pi, 3 * pj) += Bi.transpose() * M[i][j] * (bj * Av[vs[j]]);
+          }
+      }
+    if (!q_derivatives) continue;
+    // Subspace DoFs: ∂x_s/∂q = Σ_i λ_i J_{v_i}.
+    std::array<Eigen::Matrix<double, 3, Eigen::Dynamic>, 3> Jv;
+    std::array<std::vector<int>, 3> cv;
+    for (int i = 0; i < 3; ++i) vertices_.local_jacobian(c.vertices[vs[i]], q, L, Jv[i], cv[i]);
+    for (int i = 0; i < 3; ++i) {
+      add_offset_rotation_gradient(a.surface_weights.row(c.vertices[vs[i]]), q.bones, offset[vs[i]], g[i], L, out.gq);
+      const Eigen::VectorXd gi = Jv[i].transpose() * g[i];
+      for (size_t k = 0; k < cv[i].size(); ++k) out.gq[cv[i][k]] += gi[k];
+      for (int j = 0; j < 3; ++j) {
+        const MatX B = Jv[i].transpose() * M[i][j] * Jv[j];
+        for (size_t k = 0; k < cv[i].size(); ++k)
+          for (size_t l = 0; l < cv[j].size(); ++l) out.Hqq(cv[i][k], cv[j][l]) += B(k, l);
+        for (const auto& [pj, bj] : couple[vs[j]]) {
+          if (pj < 0 || bj == 0.0) continue;
+          const MatX C = Jv[i].transpose() * M[i][j] * (bj * Av[vs[j]]);
+          for (size_t k = 0; k < cv[i].size(); ++k) out.Hqp.block<1, 3>(cv[i][k], 3 * pj) += C.row(k);
+        }
+      }
+    }
+  }
+  return out.energy = E;
+}
+
+VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
+  PatchCache& c = patch_cache(ctx, name());
+  VecX du = c.du;
+  if (du.size() == 0) return du;
+  Evaluation ev, trial;
+  double g0 = -1;
+  for (int it = 0; it < options_.max_inner_iterations; ++it) {
+    const double E0 = evaluate_patch(ctx, q, du, false, ev);
+    require(std::isfinite(E0), name(), ": the patch's start is inadmissible (an inverted tet)");
+    const double gn = ev.gp.norm();
+    if (g0 < 0) g0 = gn;
+    if (gn <= options_.inner_tolerance * g0 || gn < 1e-12) break;
+    Eigen::LLT<MatX> llt(ev.Hpp);
+    if (llt.info() != Eigen::Success) {
+      // PSD by construction and PD with mass: only a degenerate tet gets here.
+      MatX H = ev.Hpp;
+      H.diagonal() *= 1.0 + 1e-8;
+      llt.compute(H);
+      require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+    }
+    const VecX step = llt.solve(-ev.gp);
+    const double slope = ev.gp.dot(step);
+    double alpha = 1;
+    bool ok = false;
+    for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
+      const double E1 = evaluate_patch(ctx, q, du + alpha * step, false, trial);
+      if (std::isfinite(E1) && E1 <= E0 + 1e-4 * alpha * slope + 1e-15 * std::abs(E0)) {
+        ok = true;
+        break;
+      }
+    }
+    if (!ok) break;
+    du += alpha * step;
+    if (alpha * step.cwiseAbs().maxCoeff() < 1e-13) break;
+  }
+  c.du = du;
+  return du;
+}
+
+double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
+  const VecX du = minimize_patch(ctx, q);
+  Evaluation ev;
+  const double E = evaluate_patch(ctx, q, du, grad || hess, ev);
+  if (!std::isfinite(E) || (!grad && !hess)) return E;
+  if (grad) *grad += ev.gq;
+  if (!hess) return E;
+  *hess += ev.Hqq;
+  if (du.size() == 0) return E;
+  // Schur complement over the rows of the layout the patch touches.
+  std::vector<int> rows;
+  for (int r = 0; r < ev.Hqp.rows(); ++r)
+    if (ev.Hqp.row(r).squaredNorm() > 0) rows.push_back(r);
+  if (rows.empty()) return E;
+  MatX Hc(ev.Hqp.cols(), int(rows.size()));
+  for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
+  Eigen::LLT<MatX> llt(ev.Hpp);
+  require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+  const MatX X = llt.matrixL().solve(Hc);
+  const MatX S = X.transpose() * X;
+  for (size_t k = 0; k < rows.size(); ++k)
+    for (size_t l = 0; l < rows.size(); ++l) (*hess)(rows[k], rows[l]) -= S(int(k), int(l));
+  return E;
+}
+
+std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const Configuration& q) const {
+  PatchCache& c = patch_cache(ctx, name());
+  const VecX du = minimize_patch(ctx, q);
+  Evaluation ev;
+  evaluate_patch(ctx, q, du, false, ev);
+  double max_du = 0;
+  VecX packed(4 * c.nodes.size());
+  for (size_t i = 0; i < c.nodes.size(); ++i) {
+    const int n = c.nodes[i];
+    PatchHistory& h = c.history[n];
+    h.du_next = du.segment<3>(3 * i);
+    h.d_next = blend_rotation(avatar_->node_weights.row(n), q.bones) * h.du_next;
+    max_du = std::max(max_du, h.du_next.norm());
+    packed.segment<4>(4 * i) << double(n), h.du_next;
+  }
+  return {{"force", "N", ev.force},
+          {"active_samples", "", VecX::Constant(1, ev.active)},
+          {"max_penetration", "m", VecX::Constant(1, ev.depth)},
+          {"contact_area", "m^2", VecX::Constant(1, ev.area)},
+          {"patch_nodes", "", VecX::Constant(1, double(c.nodes.size()))},
+          {"max_patch_displacement", "m", VecX::Constant(1, max_du)},
+          {"patch_displacement", "m", packed}};
+}
+
+Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {
+  std::unordered_map<int, Vec3> du;
+  for (const TermQuantityReport& q : report.quantities) {
+    if (q.body != body || q.name != "patch_displacement") continue;
+    require(q.value.size() % 4 == 0, "patch_surface_displacement: '", q.term, "' reports ", q.value.size(),
+            " values, expected 4 per patch node");
+    for (size_t i = 0; i < q.value.size(); i += 4) {
+      const int n = int(q.value[i]);
+      require(n >= 0 && n < a.tet.num_nodes(), "patch_surface_displacement: node ", n, " out of [0, ",
+              a.tet.num_nodes(), ")");
+      du[n] += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
+    }
+  }
+  Points u = Points::Zero(a.surface_rest.rows(), 3);
+  if (du.empty()) return u;
+  for (int v = 0; v < u.rows(); ++v)
+    for (int c = 0; c < 4; ++c) {
+      const auto it = du.find(a.tet.elements(a.surface_tet[v], c));
+      if (it != du.end()) u.row(v) += a.surface_bary(v, c) * it->second.transpose();
+    }
+  return u;
+}
+
+}  // namespace sflsh

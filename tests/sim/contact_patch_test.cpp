@@ -1,0 +1,251 @@
+// Contact sampled over the skin's faces and the full-space patch under it
+// (sim/energies/contact_patch.hpp): the force of a uniform penetration by
+// hand (κ × depth × area, whatever the sampling), the gradient of the
+// condensed energy against finite differences, the patch's limit (covering
+// the whole body, a coarse subspace plus the patch takes the same step as the
+// nodal full space), and bad options.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+
+#include <Eigen/Eigenvalues>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/geometry/primitive_sdfs.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
+#include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/energies/inertia.hpp"
+#include "sflsh/sim/simulator.hpp"
+#include "sflsh/sim/soft_tissue_terms.hpp"
+#include "synthetic_avatar.hpp"
+#include "test_support.hpp"
+
+namespace sflsh {
+namespace {
+
+/// A 6 × 3 × 4-cube box of 1 cm cubes (top face 6 cm × 4 cm at y = 3 cm), one material.
+Avatar slab(int handles) {
+  test::SyntheticAvatarOptions o;
+  o.nx = 6, o.ny = 3, o.nz = 4;
+  o.cell = 0.01;
+  o.handles = handles;
+  o.handle_radius = 0.05;
+  o.two_regions = false;
+  o.rotated_frames = false;
+  return test::make_synthetic_avatar(o);
+}
+
+StepContext context(const Avatar& a, const std::map<std::string, WorldFrame>* frames, bool bones_dynamic) {
+  StepContext ctx;
+  ctx.avatar = &a;
+  ctx.layout.num_reduced = a.num_reduced();
+  ctx.layout.bones_dynamic = bones_dynamic;
+  ctx.h = 1.0 / 60.0;
+  ctx.gravity = Vec3::Zero();
+  ctx.q_prev.bones = identity_bones();
+  ctx.q_prev.z = VecX::Zero(a.num_reduced());
+  ctx.q_prev2 = ctx.q_prev;
+  ctx.frames = frames;
+  return ctx;
+}
+
+double quantity(const std::vector<TermQuantity>& r, const std::string& name, int i = 0) {
+  for (const TermQuantity& q : r)
+    if (q.name == name) return q.value[i];
+  ADD_FAILURE() << "no quantity " << name;
+  return NAN;
+}
+
+TEST(ContactPatch, UniformPenetrationGivesPressureStiffnessTimesDepthTimesArea) {
+  // The slab's skin reduced to its top face (y = 3 cm, 6 cm × 4 cm), and a
+  // half-space whose surface is 0.7 mm below it: every sample is 0.7 mm deep,
+  // so the force is κ δ A along −y, at any spacing.
+  Avatar a = slab(0);
+  std::vector<int> top;
+  for (int f = 0; f < a.surface_faces.rows(); ++f) {
+    bool on_top = true;
+    for (int i = 0; i < 3; ++i) on_top = on_top && a.surface_rest(a.surface_faces(f, i), 1) > 0.03 - 1e-9;
+    if (on_top) top.push_back(f);
+  }
+  a.surface_faces = Triangles(a.surface_faces(top, Eigen::all));
+  ASSERT_EQ(int(top.size()), 2 * 6 * 4);
+  std::map<std::string, WorldFrame> frames;
+  frames["floor"].pose = Isometry::Identity();
+  frames["floor"].pose.linear() = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix();  // normal −y
+  frames["floor"].pose.translation() = Vec3(0, 0.03 - 0.0007, 0);
+  const double kappa = 3.0e7, depth = 0.0007, area = 0.06 * 0.04;
+  for (double spacing : {0.02, 0.004, 0.0015}) {
+    ContactPatchOptions o;
+    o.pressure_stiffness = kappa;
+    o.spacing = spacing;
+    o.patch = false;
+    const ContactPatchTerm term("floor", a, std::make_shared<geometry::PlaneSdf>(Vec3(0, 1, 0), 0.0),
+                                Isometry::Identity(), o);
+    StepContext ctx = context(a, &frames, false);
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_TRUE(term.active(ctx));
+    const auto r = term.report(ctx, ctx.q_prev);
+    EXPECT_NEAR(quantity(r, "force", 1), -kappa * depth * area, 1e-9 * kappa * depth * area) << spacing;
+    EXPECT_NEAR(quantity(r, "force", 0), 0.0, 1e-12);
+    EXPECT_NEAR(quantity(r, "max_penetration"), depth, 1e-12);
+    EXPECT_NEAR(quantity(r, "contact_area"), area, 1e-12 * area) << spacing;
+    EXPECT_NEAR(term.evaluate(ctx, ctx.q_prev, nullptr, nullptr), 0.5 * kappa * depth * depth * area,
+                1e-9 * kappa * depth * depth * area);
+  }
+}
+
+TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
+  const Avatar a = slab(6);
+  // A 1.2 cm ball 2 mm (large strain on 1 cm cells) and 0.5 mm into the top.
+  for (double press : {0.002, 0.0005}) {
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - press, -0.003);
+  ContactPatchOptions o;
+  o.pressure_stiffness = 2.0e7;
+  o.spacing = 0.003;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-13;
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), o);
+  for (bool dynamic : {false, true}) {
+    StepContext ctx = context(a, &frames, dynamic);
+    // Some subspace displacement and a moved body, so every piece is non-trivial.
+    Configuration q = ctx.q_prev;
+    for (int i = 0; i < q.z.size(); ++i) q.z[i] = press * 0.5 * std::sin(1.7 * i + 0.3);
+    ctx.q_prev2.z = -0.5 * q.z;
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_FALSE(term.patch_nodes(ctx).empty());
+    const int n = ctx.layout.size();
+    VecX g = VecX::Zero(n);
+    const double E = term.evaluate(ctx, q, &g, nullptr);
+    ASSERT_GT(E, 0);
+    VecX fd(n);
+    const double eps = 1e-7;
+    for (int i = 0; i < n; ++i) {
+      VecX d = VecX::Zero(n);
+      d[i] = eps;
+      const double Ep = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
+      d[i] = -eps;
+      const double Em = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
+      fd[i] = (Ep - Em) / (2 * eps);
+    }
+    EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "bones dynamic " << dynamic << ", " << press << " m: |g| " << g.norm()
+                                                  << ", |fd| " << fd.norm();
+    // The term alone subtracts the subspace's stiffness of the patch's tets
+    // (the patch takes their load): with the subspace's own elasticity and
+    // inertia, the step's Hessian is positive semi-definite at small strain
+    // (the bones without skinning weight carry no mass: zero eigenvalues).
+    // At 20 % strain the left-out K(Wz + δu) − K(Wz) makes it indefinite by
+    // ~2e-4 of its norm, which Newton's regularization absorbs.
+    if (press > 0.001) continue;
+    MatX H = MatX::Zero(n, n);
+    term.evaluate(ctx, q, nullptr, &H);
+    const ElasticTerm elastic(a, true, true, false);
+    const InertiaTerm inertia(a);
+    for (const EnergyTerm* t : {static_cast<const EnergyTerm*>(&elastic), static_cast<const EnergyTerm*>(&inertia)}) {
+      StepContext tctx = ctx;
+      const auto tcache = begin_term_step(*t, tctx);
+      t->evaluate(tctx, q, nullptr, &H);
+    }
+    const Eigen::SelfAdjointEigenSolver<MatX> eig(0.5 * (H + H.transpose()));
+    EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-9 * eig.eigenvalues().maxCoeff());
+  }
+  }
+}
+
+/// Node displacement of a body after a step: W z at every node, plus the
+/// patch's δu from the term's report ("patch_displacement": node, δu).
+Points node_displacement(const Avatar& a, const VecX& z, const StepReport* rep) {
+  Points u = Points::Zero(a.tet.num_nodes(), 3);
+  for (int n = 0; n < a.tet.num_nodes(); ++n) {
+    if (a.node_role[n] != int(NodeRole::Simulated)) continue;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
+      u.row(n) += it.value() * z.segment<3>(3 * it.col()).transpose();
+  }
+  if (rep)
+    for (const TermQuantityReport& q : rep->quantities)
+      if (q.name == "patch_displacement")
+        for (size_t i = 0; i + 3 < q.value.size(); i += 4)
+          u.row(int(q.value[i])) += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]).transpose();
+  return u;
+}
+
+std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iterations) {
+  ModelOptions mo;
+  mo.h = 1.0 / 60.0;
+  mo.gravity = Vec3::Zero();
+  mo.newton.iterations = iterations;
+  mo.newton.line_search = iterations > 1;
+  mo.newton.gradient_tolerance = iterations > 1 ? 1e-11 : 0.0;
+  mo.newton.max_z_step = 0;
+  mo.newton.nonlinearity_tolerance = 0.0;
+  ModelBuilder mb(mo);
+  const int body = mb.add_body({"slab", std::make_shared<const Avatar>(a), false});
+  SoftTissueOptions so;
+  so.gravity = false;
+  so.mean_dilatation = false;  // every tet's own volume change, as the patch integrates it
+  add_soft_tissue_terms(mb, body, so);
+  ContactPatchOptions co;
+  co.pressure_stiffness = 2.0e7;
+  co.spacing = 0.003;
+  co.patch = patch;
+  co.patch_radius = 1.0;  // the whole body
+  co.inner_tolerance = 1e-13;
+  mb.add_term(std::make_shared<const ContactPatchTerm>("ball", a, std::make_shared<geometry::SphereSdf>(0.012),
+                                                       Isometry::Identity(), co),
+              {body});
+  return mb.build();
+}
+
+TEST(ContactPatch, CoveringTheWholeBodyTheStepIsTheFullSpaceStep) {
+  // The nodal basis (one handle per Simulated node, W = I, every tet and node
+  // in the cubature) is the full FEM (ReducedVsFull); converged with Newton it
+  // is the reference here. The coarse model has 4 handles and the patch over
+  // every node, and takes one Newton step per time step.
+  const Avatar nodal = slab(0), coarse = slab(4);
+  Simulator full(pressed_model(nodal, false, 60)), reduced(pressed_model(coarse, true, 1)),
+      subspace(pressed_model(coarse, false, 1));
+  StepInputs in;
+  in.bodies.resize(1);
+  in.bodies[0].bones = identity_bones();
+  double peak = 0, worst = 0, worst_subspace = 0;
+  for (int i = 1; i <= 6; ++i) {
+    // A 1.2 cm ball pressed 0.5 mm further each step, to 3 mm.
+    in.frames["ball"].pose.translation() = Vec3(0.003, 0.03 + 0.012 - 0.0005 * i, -0.002);
+    in.frames["ball"].linear_velocity = Vec3(0, -0.0005 * 60, 0);
+    const StepReport rf = full.step(in), rr = reduced.step(in), rs = subspace.step(in);
+    const Points uf = node_displacement(nodal, full.state().z, nullptr);
+    const Points ur = node_displacement(coarse, reduced.state().z, &rr);
+    const Points us = node_displacement(coarse, subspace.state().z, nullptr);
+    peak = std::max(peak, uf.cwiseAbs().maxCoeff());
+    worst = std::max(worst, (ur - uf).cwiseAbs().maxCoeff());
+    worst_subspace = std::max(worst_subspace, (us - uf).cwiseAbs().maxCoeff());
+  }
+  std::cout << "[ patch limit ] peak " << peak << " m, patch vs full " << worst << " m, subspace alone vs full " << worst_subspace << " m\n";
+  ASSERT_GT(peak, 5e-4);  // a dent of a fraction of the 3 mm
+  EXPECT_LT(worst, 1e-6 * peak) << "peak " << peak;
+  EXPECT_GT(worst_subspace, 0.1 * peak) << "the coarse subspace alone should not make the dent";
+}
+
+TEST(ContactPatch, BadOptionsAreRefusedNamingTheContact) {
+  const Avatar a = slab(4);
+  auto sphere = std::make_shared<geometry::SphereSdf>(0.01);
+  auto make = [&](ContactPatchOptions o) { ContactPatchTerm("probe", a, sphere, Isometry::Identity(), o); };
+  for (double k : {0.0, -1.0, double(NAN)}) {
+    ContactPatchOptions o;
+    o.pressure_stiffness = k;
+    test::expect_error([&] { make(o); }, {"contact with 'probe'", "pressure stiffness"});
+  }
+  for (double r : {0.0, -0.01, double(NAN)}) {
+    ContactPatchOptions o;
+    o.patch_radius = r;
+    test::expect_error([&] { make(o); }, {"contact with 'probe'", "patch radius"});
+  }
+  ContactPatchOptions o;
+  o.spacing = 0;
+  test::expect_error([&] { make(o); }, {"contact with 'probe'", "spacing"});
+}
+
+}  // namespace
+}  // namespace sflsh
