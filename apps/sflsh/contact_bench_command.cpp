@@ -22,6 +22,9 @@ struct ContactBenchArgs {
   std::vector<std::string> scenes;
   int newton_iters = 1;
   double stiffness = 2.0e4;
+  double pressure_stiffness = kDefaultPressureStiffness, spacing = kDefaultContactSpacing;
+  double patch_radius = ContactPatchOptions().patch_radius;
+  bool no_patch = false;
   std::string command_line;
 };
 
@@ -36,6 +39,13 @@ void run_contact_bench(const ContactBenchArgs& a) {
   o.settings.newton_iters = a.newton_iters;
   o.settings.stiffness = a.stiffness;
   o.settings.scenes = a.scenes;
+  o.settings.pressure_stiffness = a.pressure_stiffness;
+  o.settings.spacing = a.spacing;
+  o.settings.patch = !a.no_patch;
+  o.settings.patch_radius = a.patch_radius;
+  check_contact_sampling(a.pressure_stiffness, a.spacing, "bench-contact (--pressure-stiffness, --spacing)");
+  require(std::isfinite(a.patch_radius) && a.patch_radius > 0, "--patch-radius must be a positive number of m, got ",
+          a.patch_radius);
   require(a.newton_iters >= 1, "--newton-iters must be >= 1, got ", a.newton_iters);
   require(std::isfinite(a.stiffness) && a.stiffness > 0, "--stiffness must be a positive number of N/m, got ",
           a.stiffness);
@@ -88,11 +98,22 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
   cmd->add_option("--handles", a->handles, "Handle counts (default 32,64,128; 32 with --quick)")
       ->delimiter(',')
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--scenes", a->scenes, "Scenes to run: pressed, impact, probe (default: all)")->delimiter(',');
+  cmd->add_option("--scenes", a->scenes,
+                  "Scenes to run: pressed, impact, probe (2 cm, thigh), probe-thigh-1cm, probe-belly, probe-belly-1cm, "
+                  "probe-calf, probe-calf-1cm (default: all)")
+      ->delimiter(',');
   cmd->add_option("--newton-iters", a->newton_iters, "Reduced solver's Newton iterations per step")
       ->capture_default_str();
   cmd->add_option("--stiffness", a->stiffness, "Contact stiffness per skin sample (N/m), both solvers")
       ->capture_default_str();
+  cmd->add_option("--pressure-stiffness", a->pressure_stiffness,
+                  "Reduced solver's contact pressure stiffness (N/m^3, over the skin's area)")
+      ->capture_default_str();
+  cmd->add_option("--spacing", a->spacing, "Reduced solver's contact sample spacing on the skin's faces (m)")
+      ->capture_default_str();
+  cmd->add_option("--patch-radius", a->patch_radius, "Radius of the full-space patch under a contact (m)")
+      ->capture_default_str();
+  cmd->add_flag("--no-patch", a->no_patch, "Contact on the reduced subspace alone (no full-space patch)");
   cmd->add_option("--cache-dir", a->cache_dir, "Template-stage cache folder");
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
   cmd->add_option("--out", a->out, "Output folder (contact_bench.csv, contact_bench.md)")->capture_default_str();
@@ -105,6 +126,15 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
                       handles +
                       (a->newton_iters != 1 ? " --newton-iters " + std::to_string(a->newton_iters) : "") +
                       (a->stiffness != 2.0e4 ? stiffness : "") + (a->betas.empty() ? "" : " --betas " + a->betas);
+    for (size_t i = 0; i < a->scenes.size(); ++i) a->command_line += (i ? "," : " --scenes ") + a->scenes[i];
+    char extra[160];
+    std::snprintf(extra, sizeof extra, "%s%s%s", a->no_patch ? " --no-patch" : "",
+                  a->pressure_stiffness != kDefaultPressureStiffness ? " --pressure-stiffness " : "",
+                  a->pressure_stiffness != kDefaultPressureStiffness ? std::to_string(a->pressure_stiffness).c_str() : "");
+    a->command_line += extra;
+    if (a->spacing != kDefaultContactSpacing) a->command_line += " --spacing " + std::to_string(a->spacing);
+    if (a->patch_radius != ContactPatchOptions().patch_radius)
+      a->command_line += " --patch-radius " + std::to_string(a->patch_radius);
     run_contact_bench(*a);
   });
 });

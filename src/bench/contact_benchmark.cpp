@@ -13,7 +13,7 @@
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/line_plot_svg.hpp"
-#include "sflsh/sim/energies/sdf_contact.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
@@ -36,7 +36,7 @@ struct Scene {
   double radius = 0, dt = 0;
   int steps = 0;
   std::function<double(double)> gap;
-  bool thigh = false;  ///< the site: the left thigh (else the belly)
+  std::string site = "belly";  ///< belly | thigh (left, front) | calf (left, back)
   Vec3 centre(const Site& s, double t) const { return s.point + s.outward * (radius + gap(t)); }
 };
 
@@ -51,6 +51,7 @@ struct Trace {
   double peak_force = 0;            // N
   std::vector<double> force;        // |contact force| per step (N)
   int unconverged = 0;              // full FEM: steps that stopped before the gradient tolerance
+  int max_patch_nodes = 0;          // reduced: largest patch
 };
 
 bool simulated_vertex(const Avatar& a, int v) {
@@ -102,6 +103,25 @@ Site thigh_site(const Avatar& a) {
   return s;
 }
 
+Site calf_site(const Avatar& a) {
+  require(a.joints_rest.rows() == 24, "bench-contact: the avatar has ", a.joints_rest.rows(), " joints, expected 24");
+  const Vec3 knee = a.joints_rest.row(4).transpose(), ankle = a.joints_rest.row(7).transpose();  // left knee, ankle
+  int best = -1;
+  double best_z = 0;
+  for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
+    const Vec3 x = a.surface_rest.row(v).transpose();
+    const double s = (x.y() - ankle.y()) / (knee.y() - ankle.y());
+    if (s < 0.5 || s > 0.7 || std::abs(x.x() - (ankle.x() + s * (knee.x() - ankle.x()))) > 0.03 || !simulated_vertex(a, v))
+      continue;
+    if (best < 0 || x.z() < best_z) best = v, best_z = x.z();  // back-most: the body faces +z
+  }
+  require(best >= 0, "bench-contact: no simulated skin vertex on the back of the left calf");
+  Site s;
+  s.point = a.surface_rest.row(best).transpose();
+  s.outward = -Vec3::UnitZ();
+  return s;
+}
+
 std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
   require(o.pressed_radius > 0 && o.impact_radius > 0 && o.impact_speed > 0 && o.pressed_depth > 0 &&
               o.impact_depth > 0 && o.pressed_dt > 0 && o.impact_dt > 0 && o.stiffness > 0 && o.newton_iters >= 1,
@@ -120,13 +140,18 @@ std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
     s.gap = [=](double t) { return t < turn ? start - v * t : -depth + v * (t - turn); };
     scenes.push_back(s);
   }
-  {
-    require(o.probe_radius > 0 && o.probe_depth > 0 && o.probe_dt > 0, "bench-contact: probe radius, depth and dt must be positive");
-    const double start = 0.002, depth = o.probe_depth, ramp = o.quick ? 0.5 : 1.5, total = ramp + (o.quick ? 0.1 : 0.25);
-    Scene s{"probe", o.probe_radius, o.probe_dt, int(std::lround(total / o.probe_dt)), nullptr, true};
-    s.gap = [=](double t) { return start - (start + depth) * std::min(std::max(t, 0.0) / ramp, 1.0); };
-    scenes.push_back(s);
-  }
+  require(o.probe_radius > 0 && o.probe_depth > 0 && o.probe_dt > 0, "bench-contact: probe radius, depth and dt must be positive");
+  // "probe": the 2 cm probe on the thigh; "probe-SITE[-1cm]": the probe (or a
+  // 1 cm one) on the belly, thigh or calf.
+  for (const char* site : {"thigh", "belly", "calf"})
+    for (bool small : {false, true}) {
+      const double start = 0.002, depth = o.probe_depth, ramp = o.quick ? 0.5 : 1.5, total = ramp + (o.quick ? 0.1 : 0.25);
+      const std::string name = std::string(site) == "thigh" && !small ? "probe"
+                                                                       : std::string("probe-") + site + (small ? "-1cm" : "");
+      Scene s{name, small ? 0.01 : o.probe_radius, o.probe_dt, int(std::lround(total / o.probe_dt)), nullptr, site};
+      s.gap = [=](double t) { return start - (start + depth) * std::min(std::max(t, 0.0) / ramp, 1.0); };
+      scenes.push_back(s);
+    }
   return scenes;
 }
 
@@ -180,11 +205,13 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
   so.mean_dilatation = o.mean_dilatation;
   add_soft_tissue_terms(mb, body, so);
   if (with_object) {
-    SdfContactOptions co;
-    co.stiffness = o.stiffness;
-    mb.add_term(std::make_shared<const SdfContactTerm>(kObject, skin_contact_samples(*avatar),
-                                                       std::make_shared<geometry::SphereSdf>(sc.radius),
-                                                       Isometry::Identity(), false, co),
+    ContactPatchOptions co;
+    co.pressure_stiffness = o.pressure_stiffness;
+    co.spacing = o.spacing;
+    co.patch = o.patch;
+    co.patch_radius = o.patch_radius;
+    mb.add_term(std::make_shared<const ContactPatchTerm>(kObject, *avatar, std::make_shared<geometry::SphereSdf>(sc.radius),
+                                                         Isometry::Identity(), co),
                 {body});
   }
   Simulator sim(mb.build());
@@ -202,12 +229,13 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
     f.linear_velocity = (sc.centre(site, t) - sc.centre(site, t - sc.dt)) / sc.dt;
     const StepReport rep = sim.step(in);
     require(sim.state().z.allFinite(), "bench-contact: the reduced ", sc.name, " run became non-finite at step ", i);
-    tr.u.push_back(sim.soft_displacement());
+    tr.u.push_back(sim.soft_displacement() + patch_surface_displacement(*avatar, rep));
     tr.ms.push_back(rep.ms_total);
     int active = 0;
     double force = 0;
     for (const TermQuantityReport& q : rep.quantities)
       if (q.term == term && q.name == "active_samples") active = int(q.value.at(0));
+      else if (q.term == term && q.name == "patch_nodes") tr.max_patch_nodes = std::max(tr.max_patch_nodes, int(q.value.at(0)));
       else if (q.term == term && q.name == "force") force = Vec3(q.value.at(0), q.value.at(1), q.value.at(2)).norm();
     tr.peak_force = std::max(tr.peak_force, force);
     tr.force.push_back(force);
@@ -253,6 +281,20 @@ double force_at_depth(const std::vector<double>& depth_mm, const std::vector<dou
   return std::nan("");
 }
 
+/// RMS over the loading ramp's steps at 2–10 mm depth of (F_red − F_full) / F_full; NaN without such steps.
+double loading_force_rms_error(const std::vector<double>& depth_mm, const std::vector<double>& full,
+                               const std::vector<double>& reduced) {
+  double sum = 0;
+  int n = 0;
+  for (size_t i = 0; i < depth_mm.size() && i < full.size() && i < reduced.size(); ++i) {
+    if (i > 0 && depth_mm[i] <= depth_mm[i - 1]) break;  // the ramp ends
+    if (depth_mm[i] < 2.0 || depth_mm[i] > 10.0 || !(full[i] > 0)) continue;
+    sum += std::pow((reduced[i] - full[i]) / full[i], 2);
+    ++n;
+  }
+  return n > 0 ? std::sqrt(sum / n) : std::nan("");
+}
+
 double relative_error(const Trace& tr, const Trace& ref) {
   double diff2 = 0, ref2 = 0;
   for (size_t f = 0; f < std::min(tr.u.size(), ref.u.size()); ++f) {
@@ -273,7 +315,7 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
                 a->surface_rest.rows() == base.surface_rest.rows(),
             "bench-contact: the avatars do not share the tet mesh and skin (", a->tet.num_nodes(), " vs ",
             base.tet.num_nodes(), " nodes)");
-  const Site belly = belly_site(base), thigh = thigh_site(base);
+  const Site belly = belly_site(base), thigh = thigh_site(base), calf = calf_site(base);
   log_info("bench-contact: belly point (" + std::to_string(belly.point.x()) + ", " + std::to_string(belly.point.y()) +
            ", " + std::to_string(belly.point.z()) + ") m, thigh point (" + std::to_string(thigh.point.x()) + ", " +
            std::to_string(thigh.point.y()) + ", " + std::to_string(thigh.point.z()) + ") m");
@@ -281,13 +323,14 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
   for (const std::string& name : settings.scenes) {
     bool known = false;
     for (const Scene& sc : make_scenes(settings)) known = known || sc.name == name;
-    require(known, "bench-contact: unknown scene '", name, "' (scenes: pressed, impact, probe)");
+    require(known, "bench-contact: unknown scene '", name,
+            "' (scenes: pressed, impact, probe, probe-thigh-1cm, probe-belly, probe-belly-1cm, probe-calf, probe-calf-1cm)");
   }
   for (const Scene& sc : make_scenes(settings)) {
     if (!settings.scenes.empty() &&
         std::find(settings.scenes.begin(), settings.scenes.end(), sc.name) == settings.scenes.end())
       continue;
-    const Site& site = sc.thigh ? thigh : belly;
+    const Site& site = sc.site == "thigh" ? thigh : sc.site == "calf" ? calf : belly;
     const Trace ref = run_full(avatars[0], sc, site, settings);
     const double reach = 1.5 * sc.radius;
     const double dent_ref = peak_dent(ref, base, site, reach);
@@ -318,6 +361,8 @@ std::vector<ContactBenchRow> run_contact_scenes(const std::vector<std::shared_pt
       r.force_at_depth_full_n = force_at_depth(r.curve_depth_mm, ref.force, settings.probe_report_depth);
       r.force_at_depth_reduced_n = force_at_depth(r.curve_depth_mm, with.force, settings.probe_report_depth);
       r.force_err = std::abs(r.force_at_depth_reduced_n - r.force_at_depth_full_n) / r.force_at_depth_full_n;
+      r.force_rms_err = loading_force_rms_error(r.curve_depth_mm, ref.force, with.force);
+      r.max_patch_nodes = with.max_patch_nodes;
       rows.push_back(r);
     }
   }
@@ -419,13 +464,17 @@ void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, cons
     }
     bool header = false;
     for (const auto& r : rows) {
-      if (r.scene != "probe") continue;
+      if (r.scene.rfind("probe", 0) != 0) continue;
       if (!header)
-        f << "\nProbe force at 10 mm depth (first crossing on the loading ramp):\n\n| K | full FEM (N) | reduced (N) | "
-             "error |\n|---|---|---|---|\n";
+        f << "\nProbes: force at 10 mm depth (first crossing on the loading ramp), the RMS of the relative force "
+             "error over the loading curve at 2–10 mm, the dent, and the largest patch:\n\n| scene | K | full FEM (N) | "
+             "reduced (N) | error at 10 mm | RMS error 2–10 mm | dent full / reduced (mm) | patch nodes |\n"
+             "|---|---|---|---|---|---|---|---|\n";
       header = true;
-      std::snprintf(buf, sizeof buf, "| %d | %.2f | %.2f | %.0f %% |\n", r.handles, r.force_at_depth_full_n,
-                    r.force_at_depth_reduced_n, 100.0 * r.force_err);
+      std::snprintf(buf, sizeof buf, "| %s | %d | %.2f | %.2f | %.0f %% | %.0f %% | %.2f / %.2f | %d |\n",
+                    r.scene.c_str(), r.handles, r.force_at_depth_full_n, r.force_at_depth_reduced_n,
+                    100.0 * r.force_err, 100.0 * r.force_rms_err, r.dent_full_mm, r.dent_reduced_mm,
+                    r.max_patch_nodes);
       f << buf;
     }
     if (!f) fail(path, ": write failed");

@@ -42,6 +42,7 @@
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/precompute/precompute.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
 
 namespace sflsh {
@@ -64,6 +65,12 @@ struct ContactBenchSettings {
   /// tet's own volume change, as the full-FEM reference integrates it).
   bool mean_dilatation = SoftTissueOptions().mean_dilatation;
   double probe_report_depth = 0.01;  ///< m: force_err is taken there
+  /// The reduced solver's contact (sim/energies/contact_patch.hpp): pressure
+  /// stiffness κ (N/m³), face sample spacing (m), and the full-space patch.
+  double pressure_stiffness = kDefaultPressureStiffness;
+  double spacing = kDefaultContactSpacing;
+  bool patch = true;
+  double patch_radius = ContactPatchOptions().patch_radius;
   std::vector<std::string> scenes;   ///< which scenes to run (empty: pressed, impact, probe)
 };
 
@@ -94,6 +101,9 @@ struct ContactBenchRow {
   /// The forces at settings.probe_report_depth (first crossing, interpolated)
   /// and their relative difference |F_red − F_full| / F_full (probe scene).
   double force_at_depth_full_n = 0, force_at_depth_reduced_n = 0, force_err = 0;
+  /// RMS of (F_red − F_full) / F_full over the loading ramp's steps at 2–10 mm (probe scenes).
+  double force_rms_err = 0;
+  int max_patch_nodes = 0;  ///< reduced: the largest contact patch (nodes)
 };
 
 /// Runs both scenes on `avatars` (one per handle count; they must share the

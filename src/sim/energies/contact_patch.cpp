@@ -50,6 +50,15 @@ struct PatchCache : TermCache {
   std::vector<int> tets;                       // tets with a patch node
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
   VecX du;                                     // last minimizer (3 per patch node)
+  int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
+  // The configuration `du` minimizes Φ at (skipped when asked again), and the
+  // linearization of the last Hessian evaluation: δu(z) ≈ du_lin − Φ_pp⁻¹ Φ_pz (z − z_lin).
+  bool solved = false;
+  Configuration q_solved;
+  bool linearized = false;
+  VecX z_lin, du_lin;
+  MatX Hpz;                     // Φ_pz (patch DoFs by z)
+  Eigen::LLT<MatX> Hpp_llt;
   std::unordered_map<int, PatchHistory> history;
 };
 
@@ -242,6 +251,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   c.x_star.assign(P, Vec3::Zero());
   c.d_pred.assign(P, Vec3::Zero());
   c.du = VecX::Zero(3 * P);
+  c.inner_iterations = c.minimizations = 0;
+  c.solved = c.linearized = false;
   for (size_t i = 0; i < P; ++i) {
     const int n = c.nodes[i];
     const Vec3 xt = nodes_.world_point(n, qt);
@@ -258,8 +269,9 @@ bool ContactPatchTerm::active(const StepContext& ctx) const {
   return !c.faces.empty() || !c.nodes.empty();
 }
 
-double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, bool q_derivatives,
-                                  Evaluation& out) const {
+double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du,
+                                        const EvaluationMode& mode, Evaluation& out) const {
+  const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
   const PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
   const DofLayout& L = local_layout(ctx);
@@ -288,6 +300,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     const Vec3 e = d - c.d_pred[i];
     const Vec3 r = nodes_.world_point(n, q) - c.x_star[i];
     E += 0.5 * m * inv_h2 * (2 * r.dot(e) + e.squaredNorm()) - m * ctx.gravity.dot(d);
+    if (!p_derivatives) continue;
     const Vec3 fd = m * inv_h2 * (r + e) - m * ctx.gravity;  // ∂Φ/∂d
     out.gp.segment<3>(3 * i) += A[i].transpose() * fd;
     out.Hpp.block<3, 3>(3 * i, 3 * i) += m * inv_h2 * A[i].transpose() * A[i];
@@ -320,11 +333,15 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     }
     Mat3 P0, P1;
     Mat9 H1;
-    const double psi1 = strain_energy_density(F1, materials_[t], &P1, &H1, true);
+    const double psi1 = strain_energy_density(F1, materials_[t], p_derivatives ? &P1 : nullptr,
+                                              p_derivatives ? &H1 : nullptr, mode.project);
     if (!std::isfinite(psi1)) return out.energy = std::numeric_limits<double>::infinity();
-    const double psi0 = strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, nullptr, false);
     const double V = tet_volume_[t];
-    E += V * (psi1 - psi0);
+    E += V * psi1;
+    // The subspace's own energy of the tet: constant while δu varies (left out then).
+    if (mode.subspace_energy || q_derivatives)
+      E -= V * strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, nullptr, false);
+    if (!p_derivatives) continue;
     // Element blocks K_kl (3x3) = V Σ_{b,l} ∇N_k[b] H1(i + 3b, j + 3l) ∇N_l[l].
     std::array<std::array<Mat3, 4>, 4> K;
     for (int k = 0; k < 4; ++k)
@@ -381,11 +398,14 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     offset[i] = off;
     xv[i] = vertices_.world_point(v, q) + Av[i] * off;
   }
+  // Per vertex (slot): g_v = Σ_s λ_v g_s, and per vertex pair M_vw = Σ_s λ_v λ_w H_s
+  // over the touching samples of their faces; the Jacobians are applied once per vertex pair.
+  std::vector<Vec3> gv(p_derivatives ? nv : 0, Vec3::Zero());
+  std::unordered_map<long, Mat3> Mvw;
   for (size_t fi = 0; fi < c.faces.size(); ++fi) {
     const int fc = c.faces[fi];
     std::array<int, 3> vs;
     for (int i = 0; i < 3; ++i) vs[i] = c.vertex_slot.at(a.surface_faces(fc, i));
-    // Per face: g_i = Σ_s λ_i g_s and M_ij = Σ_s λ_i λ_j H_s over its touching samples.
     std::array<Vec3, 3> g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
     std::array<std::array<Mat3, 3>, 3> M;
     for (auto& row : M) row.fill(Mat3::Zero());
@@ -395,7 +415,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
       const Vec3 x = smp.lambda[0] * xv[vs[0]] + smp.lambda[1] * xv[vs[1]] + smp.lambda[2] * xv[vs[2]];
       const geometry::SdfSample sd = field_->evaluate(T_inv * x);
       if (!(sd.distance < 0)) continue;
-      touching = true;
+      touching = p_derivatives;
       const double k = kappa * smp.area, d = sd.distance;
       const Vec3 nrm = T.linear() * sd.gradient;
       E += 0.5 * k * d * d;
@@ -403,6 +423,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
       ++out.active;
       out.depth = std::max(out.depth, -d);
       out.area += smp.area;
+      if (!p_derivatives) continue;
       const Mat3 H = k * nrm * nrm.transpose();
       for (int i = 0; i < 3; ++i) {
         g[i] += smp.lambda[i] * k * d * nrm;
@@ -410,68 +431,108 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
       }
     }
     if (!touching) continue;
-    // Patch DoFs: ∂x_s/∂δu_c = λ_i b_ic A_i.
-    for (int i = 0; i < 3; ++i)
-      for (const auto& [pi, bi] : couple[vs[i]]) {
-        if (pi < 0 || bi == 0.0) continue;
-        const Mat3 Bi = bi * Av[vs[i]];
-        out.gp.segment<3>(3 * pi) += Bi.transpose() * g[i];
-        for (int j = 0; j < 3; ++j)
-          for (const auto& [pj, bj] : couple[vs[j]]) {
-            if (pj < 0 || bj == 0.0) continue;
-            out.Hpp.block<3, 3>(3 * pi, 3 * pj) += Bi.transpose() * M[i][j] * (bj * Av[vs[j]]);
-          }
-      }
-    if (!q_derivatives) continue;
-    // Subspace DoFs: ∂x_s/∂q = Σ_i λ_i J_{v_i}.
-    std::array<Eigen::Matrix<double, 3, Eigen::Dynamic>, 3> Jv;
-    std::array<std::vector<int>, 3> cv;
-    for (int i = 0; i < 3; ++i) vertices_.local_jacobian(c.vertices[vs[i]], q, L, Jv[i], cv[i]);
     for (int i = 0; i < 3; ++i) {
-      add_offset_rotation_gradient(a.surface_weights.row(c.vertices[vs[i]]), q.bones, offset[vs[i]], g[i], L, out.gq);
-      const Eigen::VectorXd gi = Jv[i].transpose() * g[i];
-      for (size_t k = 0; k < cv[i].size(); ++k) out.gq[cv[i][k]] += gi[k];
-      for (int j = 0; j < 3; ++j) {
-        const MatX B = Jv[i].transpose() * M[i][j] * Jv[j];
-        for (size_t k = 0; k < cv[i].size(); ++k)
-          for (size_t l = 0; l < cv[j].size(); ++l) out.Hqq(cv[i][k], cv[j][l]) += B(k, l);
-        for (const auto& [pj, bj] : couple[vs[j]]) {
-          if (pj < 0 || bj == 0.0) continue;
-          const MatX C = Jv[i].transpose() * M[i][j] * (bj * Av[vs[j]]);
-          for (size_t k = 0; k < cv[i].size(); ++k) out.Hqp.block<1, 3>(cv[i][k], 3 * pj) += C.row(k);
-        }
-      }
+      gv[vs[i]] += g[i];
+      for (int j = 0; j < 3; ++j)
+        Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
+    }
+  }
+  if (!p_derivatives || Mvw.empty()) return out.energy = E;
+  // Patch DoFs: ∂x_v/∂δu_c = b_vc A_v.
+  for (size_t v = 0; v < nv; ++v)
+    for (const auto& [pi, bi] : couple[v])
+      if (pi >= 0 && bi != 0.0) out.gp.segment<3>(3 * pi) += (bi * Av[v]).transpose() * gv[v];
+  for (const auto& [key, M] : Mvw) {
+    const int v = int(key / long(nv)), w = int(key % long(nv));
+    for (const auto& [pi, bi] : couple[v]) {
+      if (pi < 0 || bi == 0.0) continue;
+      const Mat3 BM = (bi * Av[v]).transpose() * M;
+      for (const auto& [pj, bj] : couple[w])
+        if (pj >= 0 && bj != 0.0) out.Hpp.block<3, 3>(3 * pi, 3 * pj) += BM * (bj * Av[w]);
+    }
+  }
+  if (!q_derivatives) return out.energy = E;
+  // Subspace DoFs: ∂x_v/∂q = J_v (and the offsets' rotation with the bones).
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> Jv(nv);
+  std::vector<std::vector<int>> cv(nv);
+  std::vector<char> touched(nv, 0);
+  for (const auto& [key, M] : Mvw) touched[size_t(key / long(nv))] = 1;
+  for (size_t v = 0; v < nv; ++v) {
+    if (!touched[v]) continue;
+    vertices_.local_jacobian(c.vertices[v], q, L, Jv[v], cv[v]);
+    add_offset_rotation_gradient(a.surface_weights.row(c.vertices[v]), q.bones, offset[v], gv[v], L, out.gq);
+    const Eigen::VectorXd gq = Jv[v].transpose() * gv[v];
+    for (size_t k = 0; k < cv[v].size(); ++k) out.gq[cv[v][k]] += gq[k];
+  }
+  for (const auto& [key, M] : Mvw) {
+    const int v = int(key / long(nv)), w = int(key % long(nv));
+    const Eigen::Matrix<double, Eigen::Dynamic, 3> JM = Jv[v].transpose() * M;
+    const MatX B = JM * Jv[w];
+    for (size_t k = 0; k < cv[v].size(); ++k)
+      for (size_t l = 0; l < cv[w].size(); ++l) out.Hqq(cv[v][k], cv[w][l]) += B(long(k), long(l));
+    for (const auto& [pj, bj] : couple[w]) {
+      if (pj < 0 || bj == 0.0) continue;
+      const Eigen::Matrix<double, Eigen::Dynamic, 3> C = JM * (bj * Av[w]);
+      for (size_t k = 0; k < cv[v].size(); ++k) out.Hqp.block<1, 3>(cv[v][k], 3 * pj) += C.row(long(k));
     }
   }
   return out.energy = E;
 }
 
+namespace {
+bool same_configuration(const Configuration& a, const Configuration& b) {
+  if (a.z.size() != b.z.size() || a.bones.size() != b.bones.size() || a.z != b.z) return false;
+  for (size_t j = 0; j < a.bones.size(); ++j)
+    if (a.bones[j].matrix() != b.bones[j].matrix()) return false;
+  return true;
+}
+}  // namespace
+
 VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
   PatchCache& c = patch_cache(ctx, name());
+  if (c.du.size() == 0) return c.du;
+  // The integrator evaluates the final configuration several times (trial,
+  // report): the minimizer is kept.
+  if (c.solved && same_configuration(q, c.q_solved)) return c.du;
   VecX du = c.du;
-  if (du.size() == 0) return du;
+  // Warm start from the last linearization: the back-substitution of the
+  // bordered Newton system for the change of z (the bones' change is left out).
+  if (c.linearized && c.z_lin.size() == q.z.size()) du = c.du_lin - c.Hpp_llt.solve(c.Hpz * (q.z - c.z_lin));
   Evaluation ev, trial;
-  double g0 = -1;
+  ++c.minimizations;
+  // Newton on δu: the exact element Hessians (quadratic convergence) unless
+  // compression makes them indefinite, then their PSD majorizers; Armijo
+  // backtracking; stops when the Newton decrement −gᵀs falls below
+  // inner_tolerance × |Φ| (or the gradient vanishes).
+  EvaluationMode exact, energy_only;
+  exact.project = false;
+  exact.subspace_energy = false;
+  energy_only.p_derivatives = false;
+  energy_only.subspace_energy = false;
   for (int it = 0; it < options_.max_inner_iterations; ++it) {
-    const double E0 = evaluate_patch(ctx, q, du, false, ev);
+    const double E0 = evaluate_patch(ctx, q, du, exact, ev);
     require(std::isfinite(E0), name(), ": the patch's start is inadmissible (an inverted tet)");
-    const double gn = ev.gp.norm();
-    if (g0 < 0) g0 = gn;
-    if (gn <= options_.inner_tolerance * g0 || gn < 1e-12) break;
+    if (ev.gp.norm() < 1e-12) break;
     Eigen::LLT<MatX> llt(ev.Hpp);
     if (llt.info() != Eigen::Success) {
-      // PSD by construction and PD with mass: only a degenerate tet gets here.
-      MatX H = ev.Hpp;
-      H.diagonal() *= 1.0 + 1e-8;
-      llt.compute(H);
-      require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+      EvaluationMode projected = exact;
+      projected.project = true;
+      evaluate_patch(ctx, q, du, projected, ev);
+      llt.compute(ev.Hpp);
+      if (llt.info() != Eigen::Success) {
+        // PSD by construction and PD with mass: only a degenerate tet gets here.
+        ev.Hpp.diagonal() *= 1.0 + 1e-8;
+        llt.compute(ev.Hpp);
+        require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+      }
     }
     const VecX step = llt.solve(-ev.gp);
     const double slope = ev.gp.dot(step);
+    if (-slope <= options_.inner_tolerance * std::max(std::abs(E0), 1e-12)) break;
     double alpha = 1;
     bool ok = false;
     for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
-      const double E1 = evaluate_patch(ctx, q, du + alpha * step, false, trial);
+      const double E1 = evaluate_patch(ctx, q, du + alpha * step, energy_only, trial);
       if (std::isfinite(E1) && E1 <= E0 + 1e-4 * alpha * slope + 1e-15 * std::abs(E0)) {
         ok = true;
         break;
@@ -479,16 +540,22 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     }
     if (!ok) break;
     du += alpha * step;
+    ++c.inner_iterations;
     if (alpha * step.cwiseAbs().maxCoeff() < 1e-13) break;
   }
   c.du = du;
+  c.solved = true;
+  c.q_solved = q;
   return du;
 }
 
 double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   const VecX du = minimize_patch(ctx, q);
   Evaluation ev;
-  const double E = evaluate_patch(ctx, q, du, grad || hess, ev);
+  EvaluationMode mode;
+  mode.q_derivatives = grad || hess;
+  mode.p_derivatives = hess != nullptr;
+  const double E = evaluate_patch(ctx, q, du, mode, ev);
   if (!std::isfinite(E) || (!grad && !hess)) return E;
   if (grad) *grad += ev.gq;
   if (!hess) return E;
@@ -501,8 +568,15 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   if (rows.empty()) return E;
   MatX Hc(ev.Hqp.cols(), int(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
-  Eigen::LLT<MatX> llt(ev.Hpp);
+  PatchCache& c = patch_cache(ctx, name());
+  Eigen::LLT<MatX>& llt = c.Hpp_llt;
+  llt.compute(ev.Hpp);
   require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+  const DofLayout& L = local_layout(ctx);
+  c.linearized = true;
+  c.z_lin = q.z;
+  c.du_lin = du;
+  c.Hpz = ev.Hqp.middleRows(L.z_offset(), L.num_reduced).transpose();
   const MatX X = llt.matrixL().solve(Hc);
   const MatX S = X.transpose() * X;
   for (size_t k = 0; k < rows.size(); ++k)
@@ -514,7 +588,9 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
   PatchCache& c = patch_cache(ctx, name());
   const VecX du = minimize_patch(ctx, q);
   Evaluation ev;
-  evaluate_patch(ctx, q, du, false, ev);
+  EvaluationMode mode;
+  mode.p_derivatives = false;
+  evaluate_patch(ctx, q, du, mode, ev);
   double max_du = 0;
   VecX packed(4 * c.nodes.size());
   for (size_t i = 0; i < c.nodes.size(); ++i) {
@@ -531,7 +607,9 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
           {"contact_area", "m^2", VecX::Constant(1, ev.area)},
           {"patch_nodes", "", VecX::Constant(1, double(c.nodes.size()))},
           {"max_patch_displacement", "m", VecX::Constant(1, max_du)},
-          {"patch_displacement", "m", packed}};
+          {"patch_displacement", "m", packed},
+          {"patch_iterations", "", VecX::Constant(1, c.inner_iterations)},
+          {"patch_minimizations", "", VecX::Constant(1, c.minimizations)}};
 }
 
 Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {
@@ -544,7 +622,7 @@ Points patch_surface_displacement(const Avatar& a, const StepReport& report, int
       const int n = int(q.value[i]);
       require(n >= 0 && n < a.tet.num_nodes(), "patch_surface_displacement: node ", n, " out of [0, ",
               a.tet.num_nodes(), ")");
-      du[n] += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
+      du.try_emplace(n, Vec3::Zero()).first->second += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
     }
   }
   Points u = Points::Zero(a.surface_rest.rows(), 3);

@@ -68,8 +68,9 @@ struct ContactPatchOptions {
   /// m: a skin vertex is near the object when φ at time t is below this plus
   /// its motion and the object's over the step.
   double margin = 0.005;
-  int max_inner_iterations = 30;       ///< Newton iterations on δu per evaluation
-  double inner_tolerance = 1e-10;      ///< relative decrease of ‖∂Φ/∂δu‖ that ends them
+  int max_inner_iterations = 30;  ///< Newton iterations on δu per evaluation
+  /// They end when the Newton decrement −gᵀs (J) is below this share of |Φ|.
+  double inner_tolerance = 1e-9;
   double release_displacement = 1e-6;  ///< m: a node leaves the patch once |δu| is below this
   int max_handles = 8;                 ///< basis row truncation of the skin vertices (sdf_contact.hpp)
 };
@@ -98,8 +99,14 @@ class ContactPatchTerm : public EnergyTerm {
   struct Evaluation;  // one evaluation of Φ and its derivatives (contact_patch.cpp)
 
  private:
-  double evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, bool q_derivatives,
-                  Evaluation& out) const;
+  struct EvaluationMode {
+    bool q_derivatives = false;   ///< ∂Φ/∂q, Φ_qq and Φ_qp
+    bool p_derivatives = true;    ///< ∂Φ/∂δu and Φ_pp
+    bool project = true;          ///< PSD-projected element Hessians (else exact)
+    bool subspace_energy = true;  ///< include −Σ V Ψ(F(Wz)) (constant in δu)
+  };
+  double evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
+                        Evaluation& out) const;
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
 
