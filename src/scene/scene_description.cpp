@@ -430,7 +430,8 @@ ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std:
 
 ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, const SceneDescription& scene) {
   const std::string key = "contact";
-  p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs"}, "the contact settings");
+  p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs", "patch"},
+              "the contact settings");
   ContactDescription c;
   if (const auto s = n["stiffness"]) {
     const std::string sk = "contact.stiffness";
@@ -442,6 +443,21 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
   if (const auto v = n["friction"]) c.friction = p.non_negative(v, "contact.friction");
   if (const auto v = n["self_contact"]) c.self_contact = p.boolean(v, "contact.self_contact");
   if (const auto v = n["sample_spacing"]) c.sample_spacing = p.non_negative(v, "contact.sample_spacing");
+  if (const auto v = n["patch"]) {
+    const std::string pk = "contact.patch";
+    if (v.IsScalar()) {
+      c.patch = p.boolean(v, pk);
+    } else {
+      p.check_map(v, pk, {"radius", "pressure_stiffness", "spacing"}, "the contact patch settings");
+      c.patch = true;
+      if (const auto r = v["radius"]) c.patch_radius = p.positive(r, pk + ".radius");
+      if (const auto r = v["pressure_stiffness"]) c.pressure_stiffness = p.positive(r, pk + ".pressure_stiffness");
+      if (const auto r = v["spacing"]) c.patch_spacing = p.positive(r, pk + ".spacing");
+    }
+    if (c.patch && c.friction > 0)
+      p.error(v, pk, "the contact patch is frictionless; set contact.friction: 0 to use it (friction is ", c.friction,
+              ")");
+  }
   if (const auto v = n["pairs"]) {
     const std::string pk = "contact.pairs";
     if (v.IsScalar()) {
@@ -788,7 +804,12 @@ std::string scene_description_yaml(const SceneDescription& scene) {
     << "body_body" << YAML::Value << num(c.body_body_stiffness) << YAML::Key << "self" << YAML::Value << num(c.self_stiffness)
     << YAML::EndMap << YAML::Key << "friction" << YAML::Value << num(c.friction) << YAML::Key << "self_contact"
     << YAML::Value << c.self_contact << YAML::Key << "sample_spacing"
-    << YAML::Value << num(c.sample_spacing) << YAML::Key << "pairs" << YAML::Value;
+    << YAML::Value << num(c.sample_spacing);
+  if (c.patch)
+    e << YAML::Key << "patch" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "radius" << YAML::Value
+      << num(c.patch_radius) << YAML::Key << "pressure_stiffness" << YAML::Value << num(c.pressure_stiffness)
+      << YAML::Key << "spacing" << YAML::Value << num(c.patch_spacing) << YAML::EndMap;
+  e << YAML::Key << "pairs" << YAML::Value;
   if (c.all_pairs) {
     e << "all";
   } else {

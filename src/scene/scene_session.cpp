@@ -17,6 +17,7 @@
 #include "sflsh/sim/energies/capsule_contact.hpp"
 #include "sflsh/sim/energies/damping.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/energies/virtual_coupling.hpp"
 #include "sflsh/sim/finite_guard.hpp"
@@ -320,10 +321,19 @@ void SceneSession::Impl::build() {
       if (!sc.collides(b.desc->name, o.desc->name)) continue;
       auto& pts = samples[b.avatar.get()];
       if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
+      const bool dynamic = o.model_index >= 0;
+      if (c.patch && !dynamic) {
+        ContactPatchOptions po;
+        po.pressure_stiffness = c.pressure_stiffness;
+        po.spacing = c.patch_spacing;
+        po.patch_radius = c.patch_radius;
+        mb.add_term(std::make_shared<const ContactPatchTerm>(o.desc->name, *b.avatar, o.model.field, Isometry::Identity(), po),
+                    {b.model_index});
+        continue;
+      }
       SdfContactOptions co;
       co.stiffness = c.body_object_stiffness;
       co.friction = c.friction;
-      const bool dynamic = o.model_index >= 0;
       auto term = std::make_shared<const SdfContactTerm>(o.desc->name, *pts, o.model.field,
                                                          dynamic ? o.model.shape_in_body : Isometry::Identity(),
                                                          dynamic, co);
@@ -819,6 +829,16 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
     const int v0 = r.body_vertex_offsets[i], n = r.body_vertex_offsets[i + 1] - v0, k = m.bodies[i].model_index;
     positions.middleRows(v0, n) = sim.posed_surface(k);
     displacement.middleRows(v0, n) = sim.soft_displacement(k);
+    // The contact patches' dents (unposed), carried to the world by the skin's blend of bone rotations.
+    const Avatar& a = *m.bodies[i].avatar;
+    const Points dent = patch_surface_displacement(a, m.report, k);
+    for (int v = 0; v < n; ++v) {
+      if (dent.row(v).isZero()) continue;
+      Mat3 A = Mat3::Zero();
+      for (int j = 0; j < a.surface_weights.cols(); ++j) A += a.surface_weights(v, j) * sim.state(k).bones[j].linear();
+      displacement.row(v0 + v) += dent.row(v);
+      positions.row(v0 + v) += (A * dent.row(v).transpose()).transpose();
+    }
     joints.middleRows(24 * int(i), 24) = sim.joints(k);
     const VecX& z = sim.state(k).z;
     VecX grown(reduced.size() + z.size());

@@ -102,6 +102,7 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   require(std::isfinite(o.margin) && o.margin >= 0, what, ": margin ", o.margin, " m, expected >= 0");
   require(o.max_inner_iterations >= 1 && o.inner_tolerance >= 0 && o.release_displacement >= 0, what,
           ": inner iterations must be >= 1 and the tolerances >= 0");
+  require(o.max_patch_nodes >= 1, what, ": max_patch_nodes ", o.max_patch_nodes, ", expected >= 1");
   vertices_ = PosedPoints::at_surface(a);
   if (o.max_handles > 0) vertices_ = vertices_.with_truncated_rows(o.max_handles);
   const int N = a.tet.num_nodes(), T = a.tet.num_elements();
@@ -177,6 +178,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   const Configuration& qt = *b.q_prev;
   const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
   std::vector<int> near;
+  std::vector<double> near_phi;  // φ of each near vertex at t
   for (int v = 0; v < vertices_.size(); ++v) {
     const Vec3 x = vertices_.world_point(v, qt);
     const double motion = has_prev ? 2 * (x - vertices_.world_point(v, *b.q_prev2)).norm() : 0.0;
@@ -185,7 +187,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
       const Vec3 lo = box.min.array() - reach, hi = box.max.array() + reach;
       if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
     }
-    if (field_->distance(T_inv * x) < reach) near.push_back(v);
+    const double phi = field_->distance(T_inv * x);
+    if (phi < reach) near.push_back(v), near_phi.push_back(phi);
   }
   // Candidate faces and their samples.
   std::vector<char> face_mark(a.surface_faces.rows(), 0);
@@ -224,16 +227,26 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
       }
       lo.array() -= options_.patch_radius;
       hi.array() += options_.patch_radius;
+      // Each node within the radius, ranked by its distance to a near vertex
+      // plus that vertex's φ: the deepest contact's nodes first when the patch
+      // is over max_patch_nodes (a broad press).
+      std::vector<std::pair<double, int>> ranked;
       for (int n = 0; n < a.tet.num_nodes(); ++n) {
         if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
         const Vec3 y = a.tet.nodes.row(n).transpose();
         if ((y.array() < lo.array()).any() || (y.array() > hi.array()).any()) continue;
-        for (int v : near)
-          if ((y - a.surface_rest.row(v).transpose()).squaredNorm() <= r2) {
-            add_node(n);
-            break;
-          }
+        double rank = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < near.size(); ++i) {
+          const double d2 = (y - a.surface_rest.row(near[i]).transpose()).squaredNorm();
+          if (d2 <= r2) rank = std::min(rank, std::sqrt(d2) + near_phi[i]);
+        }
+        if (std::isfinite(rank)) ranked.emplace_back(rank, n);
       }
+      if (int(ranked.size()) > options_.max_patch_nodes) {
+        std::nth_element(ranked.begin(), ranked.begin() + options_.max_patch_nodes, ranked.end());
+        ranked.resize(size_t(options_.max_patch_nodes));
+      }
+      for (const auto& [rank, n] : ranked) add_node(n);
     }
     for (const auto& [n, h] : c.history) add_node(n);
   }
@@ -339,22 +352,36 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     const double V = tet_volume_[t];
     E += V * psi1;
     // The subspace's own energy of the tet: constant while δu varies (left out then).
+    Mat9 H0;
     if (mode.subspace_energy || q_derivatives)
-      E -= V * strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, nullptr, false);
+      E -= V * strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, q_derivatives ? &H0 : nullptr,
+                                     true);
     if (!p_derivatives) continue;
-    // Element blocks K_kl (3x3) = V Σ_{b,l} ∇N_k[b] H1(i + 3b, j + 3l) ∇N_l[l].
-    std::array<std::array<Mat3, 4>, 4> K;
-    for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) {
-        const Vec3 gk = grads_[t].row(k).transpose(), gl = grads_[t].row(l).transpose();
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) {
-            double v = 0;
-            for (int bb = 0; bb < 3; ++bb)
-              for (int ll = 0; ll < 3; ++ll) v += gk[bb] * H1(i + 3 * bb, j + 3 * ll) * gl[ll];
-            K[k][l](i, j) = V * v;
-          }
-      }
+    // Element blocks K_kl (3x3) = V Σ_{b,l} ∇N_k[b] H(i + 3b, j + 3l) ∇N_l[l].
+    auto element_blocks = [&](const Mat9& H) {
+      std::array<std::array<Mat3, 4>, 4> K;
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) {
+          const Vec3 gk = grads_[t].row(k).transpose(), gl = grads_[t].row(l).transpose();
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+              double v = 0;
+              for (int bb = 0; bb < 3; ++bb)
+                for (int ll = 0; ll < 3; ++ll) v += gk[bb] * H(i + 3 * bb, j + 3 * ll) * gl[ll];
+              K[k][l](i, j) = V * v;
+            }
+        }
+      return K;
+    };
+    const auto K = element_blocks(H1);
+    // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken at the subspace's own
+    // state, Wᵀ K(Wz): the Schur complement Wᵀ K0 (K1 + M + C)⁻¹ K0 W then
+    // stays below the subspace's stiffness of these tets, Wᵀ K0 W, which its
+    // elastic term carries, so the step's Hessian stays positive semi-definite
+    // where the dent stiffens the tissue (K1 ≫ K0 under the Fung saturation).
+    // Only the Hessian is approximated: the gradient and the energy are exact.
+    std::array<std::array<Mat3, 4>, 4> K0;
+    if (q_derivatives) K0 = element_blocks(H0);
     for (int k = 0; k < 4; ++k) {
       const Vec3 gk = grads_[t].row(k).transpose();
       if (slot[k] >= 0) {
@@ -370,7 +397,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
         const int row = z0 + 3 * int(it.col());
         out.gq.segment<3>(row) += it.value() * dg;
         for (int l = 0; l < 4; ++l)
-          if (slot[l] >= 0) out.Hqp.block<3, 3>(row, 3 * slot[l]) += it.value() * K[k][l];
+          if (slot[l] >= 0) out.Hqp.block<3, 3>(row, 3 * slot[l]) += it.value() * K0[k][l];
       }
     }
   }
@@ -500,18 +527,25 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   if (c.linearized && c.z_lin.size() == q.z.size()) du = c.du_lin - c.Hpp_llt.solve(c.Hpz * (q.z - c.z_lin));
   Evaluation ev, trial;
   ++c.minimizations;
-  // Newton on δu: the exact element Hessians (quadratic convergence) unless
-  // compression makes them indefinite, then their PSD majorizers; Armijo
-  // backtracking; stops when the Newton decrement −gᵀs falls below
-  // inner_tolerance × |Φ| (or the gradient vanishes).
   EvaluationMode exact, energy_only;
   exact.project = false;
   exact.subspace_energy = false;
   energy_only.p_derivatives = false;
   energy_only.subspace_energy = false;
+  // Newton on δu: the exact element Hessians (quadratic convergence) unless
+  // compression makes them indefinite, then their PSD majorizers; Armijo
+  // backtracking; stops when the Newton decrement −gᵀs falls below
+  // inner_tolerance × |Φ| (or the gradient vanishes).
+  // A start that inverts a tet (the warm start, or the subspace itself at
+  // this q): the last minimizer, then no patch displacement; if every start
+  // is inadmissible the term's energy is +inf there and the step backtracks.
+  if (!std::isfinite(evaluate_patch(ctx, q, du, energy_only, trial))) {
+    du = c.du;
+    if (!std::isfinite(evaluate_patch(ctx, q, du, energy_only, trial))) du.setZero();
+  }
   for (int it = 0; it < options_.max_inner_iterations; ++it) {
     const double E0 = evaluate_patch(ctx, q, du, exact, ev);
-    require(std::isfinite(E0), name(), ": the patch's start is inadmissible (an inverted tet)");
+    if (!std::isfinite(E0)) break;
     if (ev.gp.norm() < 1e-12) break;
     Eigen::LLT<MatX> llt(ev.Hpp);
     if (llt.info() != Eigen::Success) {
@@ -557,6 +591,7 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   mode.p_derivatives = hess != nullptr;
   const double E = evaluate_patch(ctx, q, du, mode, ev);
   if (!std::isfinite(E) || (!grad && !hess)) return E;
+  PatchCache& c = patch_cache(ctx, name());
   if (grad) *grad += ev.gq;
   if (!hess) return E;
   *hess += ev.Hqq;
@@ -568,7 +603,6 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   if (rows.empty()) return E;
   MatX Hc(ev.Hqp.cols(), int(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
-  PatchCache& c = patch_cache(ctx, name());
   Eigen::LLT<MatX>& llt = c.Hpp_llt;
   llt.compute(ev.Hpp);
   require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");

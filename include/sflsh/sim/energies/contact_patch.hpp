@@ -65,6 +65,9 @@ struct ContactPatchOptions {
   /// m (unposed, > 0): Simulated nodes this close to a skin vertex near the
   /// object get a full-space displacement.
   double patch_radius = 0.04;
+  /// Nodes in one patch at most (its system is dense: cost ~ nodes³): beyond,
+  /// the nodes nearest the deepest contact are kept (a broad press).
+  int max_patch_nodes = 120;
   /// m: a skin vertex is near the object when φ at time t is below this plus
   /// its motion and the object's over the step.
   double margin = 0.005;
