@@ -11,19 +11,35 @@
 // convergence with a backtracking line search; sparse supernodal Cholesky
 // (CHOLMOD), symbolic analysis once, numeric factorization per iteration.
 //
-// Rigid obstacles (issue 10; the reduced model's SdfContactTerm, sdf_contact.hpp):
-// every skin vertex v is a contact sample embedded in its tet (surface_tet,
-// surface_bary), x_v(u) = Σ_j w_vj G_j (x̄_v + Σ_c b_vc u_{n_c}) with the
-// surface skinning weights w_vj, so it matches PosedPoints::at_surface when
-// the reduced basis is complete. Each obstacle adds
-//   E_o = Σ_v ½ k_o min(φ_o(T_o⁻¹ x_v), 0)²
-// with gradient k φ b_c A_vᵀ ∇φ on node n_c (A_v = Σ_j w_vj R_j, ∇φ world) and
-// the Gauss–Newton Hessian k b_c b_d A_vᵀ ∇φ ∇φᵀ A_v (PSD); the four nodes of a
-// sample's tet are already coupled by the elastic pattern, so the sparsity
-// pattern is unchanged. Samples outside an obstacle's bounding box are skipped
-// (exactly: φ ≥ 0 there).
+// Rigid obstacles (DESIGN.md §7; skin_face_samples.hpp): contact is a
+// pressure on the skin's area, sampled over the skin's faces, so the reference
+// force does not depend on the mesh (a per-vertex load has no continuum limit:
+// a small probe touching one vertex gets a one-node force). Obstacle o with
+// pressure stiffness κ_o (N/m³) and sample spacing s_o adds
+//   E_o = Σ_s ½ κ_o a_s min(φ_o(T_o⁻¹ x_s), 0)²,   x_s = Σ_i λ_si x_{v_i}(u),
+// over the samples s of the skin faces (n² sub-triangle centroids, weight a_s =
+// rest area / n², barycentric λ_s on the face's vertices v_0..v_2), where each
+// skin vertex is embedded in its tet (surface_tet, surface_bary) and skinned:
+// x_v(u) = Σ_j w_vj G_j (x̄_v + Σ_c b_vc u_{n_c}) (surface weights w_vj), so it
+// matches PosedPoints::at_surface when the reduced basis is complete. With
+// J_s = ∂x_s/∂u = Σ_i λ_si b_{v_i c} A_{v_i} on node n_c of v_i's tet
+// (A_v = Σ_j w_vj R_j) the gradient is κ a_s φ J_sᵀ ∇φ (exact) and the Hessian
+// Gauss–Newton κ a_s J_sᵀ ∇φ ∇φᵀ J_s (PSD). J_s spans the up to 12 nodes of
+// the face's three tets, which the elastic pattern does not couple: the first
+// add_obstacle extends the sparsity pattern with every skin face's node
+// couplings (not the constructor, so scenes without obstacles keep their
+// pattern, ordering and results bit for bit).
+// Broad phase per evaluation: a face whose three current skin points' box
+// misses the obstacle's world box is skipped (exact: samples lie in the
+// triangle, φ ≥ 0 outside the box); for unbounded fields (planes) a face is
+// skipped when φ at one of its vertices exceeds its longest current edge
+// (exact for a 1-Lipschitz φ: every sample is within that edge of each vertex).
+// A candidate face's samples (per obstacle spacing) and its Hessian slots are
+// made on first use and cached.
+#include <array>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -34,6 +50,7 @@
 #include "sflsh/sim/configuration.hpp"
 #include "sflsh/sim/material.hpp"
 #include "sflsh/sim/posed_points.hpp"
+#include "sflsh/sim/skin_face_samples.hpp"
 
 namespace sflsh {
 
@@ -50,17 +67,19 @@ struct FullFemOptions {
 
 /// A rigid obstacle of the full-FEM reference; its pose is given per step (FullFem::step).
 struct FullFemObstacle {
-  std::string name;          ///< for reports
-  geometry::SdfPtr field;    ///< signed distance in the obstacle's local frame (non-null)
-  double stiffness = 2.0e4;  ///< k, N/m per skin sample (SdfContactOptions' default)
+  std::string name;        ///< for reports and errors
+  geometry::SdfPtr field;  ///< signed distance in the obstacle's local frame (non-null)
+  double pressure_stiffness = kDefaultPressureStiffness;  ///< κ, N/m³: contact pressure per metre of penetration
+  double spacing = kDefaultContactSpacing;  ///< m, sample spacing on the skin's faces (skin_face_samples.hpp)
 };
 
 /// One obstacle's contact at the end of a step.
 struct FullFemContact {
   std::string name;
-  Vec3 force = Vec3::Zero();   ///< N, world: what the obstacle exerts on the body, Σ_v −k φ_v ∇φ_v
-  int active_samples = 0;      ///< skin samples with φ < 0
+  Vec3 force = Vec3::Zero();   ///< N, world: what the obstacle exerts on the body, Σ_s −κ a_s φ_s ∇φ_s
+  int active_samples = 0;      ///< skin face samples with φ < 0
   double max_penetration = 0;  ///< m, max over samples of −φ (0 without contact)
+  double contact_area = 0;     ///< m², Σ a_s over the active samples (rest area)
 };
 
 struct FullFemReport {
@@ -85,8 +104,9 @@ class FullFem {
 
   /// u = 0, zero velocity, at `bones` (24 world transforms), time 0.
   void reset(const std::vector<Isometry>& bones);
-  /// Adds a rigid obstacle acting on every skin vertex; returns its index
-  /// (the position of its pose in step's `obstacle_poses`).
+  /// Adds a rigid obstacle acting on the skin's faces (header comment); returns
+  /// its index (the position of its pose in step's `obstacle_poses`). Throws one
+  /// line naming the obstacle for a null field, κ or spacing not finite and > 0.
   int add_obstacle(FullFemObstacle obstacle);
   int num_obstacles() const { return int(obstacles_.size()); }
   /// One backward-Euler step to t + h with the bones prescribed at `bones_next`
@@ -110,8 +130,8 @@ class FullFem {
   /// of the Simulated nodes; N) and the symmetric Hessian Newton factorizes
   /// (exact elastic and inertia blocks, Gauss–Newton contact; N/m) when non-null.
   double energy(const Points& u, VecX* gradient, Eigen::SparseMatrix<double>* hessian) const;
-  /// #V by 3 world positions of the skin samples at nodal displacement u
-  /// (no pose blend shapes: the points the contact acts on) at the current bones.
+  /// #V by 3 world positions of the skin vertices at nodal displacement u (no
+  /// pose blend shapes: the points whose faces carry the contact samples) at the current bones.
   Points skin_points(const Points& u) const;
 
  private:
@@ -120,6 +140,18 @@ class FullFem {
   double evaluate(const Points& u, VecX* grad, bool hessian);
   double evaluate_contact(const Points& u, VecX* grad, bool hessian, std::vector<FullFemContact>* report) const;
   Vec3 skin_point(int v, const Points& u) const;
+  /// Lower-CSC pattern of the Hessian (elastic + inertia; with the skin faces'
+  /// node couplings when `couple_skin_faces`) and the tet / node slot tables.
+  void build_pattern(bool couple_skin_faces);
+  /// A skin face's free nodes (of its three tets) and the lower-CSC value slot
+  /// of every entry of its 3m by 3m block (row-major, −1 above the diagonal).
+  struct FaceNodes {
+    std::vector<int> nodes;               // m free nodes
+    std::array<std::array<int, 4>, 3> local;  // per face vertex and tet corner: index into nodes or −1
+    std::vector<int> slots;               // 9 m²
+  };
+  const FaceNodes& face_nodes(int f) const;
+  const std::vector<SkinFaceSample>& face_samples(int obstacle, int f) const;
 
   std::shared_ptr<const Avatar> avatar_;
   FullFemOptions options_;
@@ -144,6 +176,9 @@ class FullFem {
   std::vector<FullFemObstacle> obstacles_;
   std::vector<Isometry> obstacle_poses_;  // at t + h during a step
   std::vector<Mat3> skin_A_;              // per skin vertex Σ_j w_vj R_j at the step's bones
+  bool skin_faces_coupled_ = false;       // pattern holds the skin faces' node couplings
+  mutable std::unordered_map<int, FaceNodes> face_nodes_;  // per candidate face, made on first use
+  mutable std::vector<std::unordered_map<int, std::vector<SkinFaceSample>>> face_samples_;  // per obstacle, per face
   mutable double ms_contact_ = 0;
 };
 
