@@ -21,7 +21,6 @@ struct ContactBenchArgs {
   std::vector<int> handles;
   std::vector<std::string> scenes;
   int newton_iters = 1;
-  double stiffness = 2.0e4;
   double pressure_stiffness = kDefaultPressureStiffness, spacing = kDefaultContactSpacing;
   double patch_radius = ContactPatchOptions().patch_radius;
   bool no_patch = false;
@@ -37,7 +36,6 @@ void run_contact_bench(const ContactBenchArgs& a) {
   ContactBenchOptions o;
   o.settings.quick = a.quick;
   o.settings.newton_iters = a.newton_iters;
-  o.settings.stiffness = a.stiffness;
   o.settings.scenes = a.scenes;
   o.settings.pressure_stiffness = a.pressure_stiffness;
   o.settings.spacing = a.spacing;
@@ -47,8 +45,6 @@ void run_contact_bench(const ContactBenchArgs& a) {
   require(std::isfinite(a.patch_radius) && a.patch_radius > 0, "--patch-radius must be a positive number of m, got ",
           a.patch_radius);
   require(a.newton_iters >= 1, "--newton-iters must be >= 1, got ", a.newton_iters);
-  require(std::isfinite(a.stiffness) && a.stiffness > 0, "--stiffness must be a positive number of N/m, got ",
-          a.stiffness);
   o.model = a.model;
   if (!a.betas.empty()) o.betas = parse_betas(a.betas);
   o.handle_counts = a.handles;  // CLI11 checks each is a whole number in [1, 4096]
@@ -104,12 +100,10 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--newton-iters", a->newton_iters, "Reduced solver's Newton iterations per step")
       ->capture_default_str();
-  cmd->add_option("--stiffness", a->stiffness, "Contact stiffness per skin sample (N/m), both solvers")
-      ->capture_default_str();
   cmd->add_option("--pressure-stiffness", a->pressure_stiffness,
-                  "Reduced solver's contact pressure stiffness (N/m^3, over the skin's area)")
+                  "Contact pressure stiffness (N/m^3, over the skin's area), both solvers")
       ->capture_default_str();
-  cmd->add_option("--spacing", a->spacing, "Reduced solver's contact sample spacing on the skin's faces (m)")
+  cmd->add_option("--spacing", a->spacing, "Contact sample spacing on the skin's faces (m), both solvers")
       ->capture_default_str();
   cmd->add_option("--patch-radius", a->patch_radius, "Radius of the full-space patch under a contact (m)")
       ->capture_default_str();
@@ -120,12 +114,10 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
   cmd->callback([a] {
     std::string handles;
     for (size_t i = 0; i < a->handles.size(); ++i) handles += (i ? "," : " --handles ") + std::to_string(a->handles[i]);
-    char stiffness[64];
-    std::snprintf(stiffness, sizeof stiffness, " --stiffness %g", a->stiffness);
     a->command_line = std::string("sflsh bench-contact") + (a->quick ? " --quick" : "") +
                       handles +
                       (a->newton_iters != 1 ? " --newton-iters " + std::to_string(a->newton_iters) : "") +
-                      (a->stiffness != 2.0e4 ? stiffness : "") + (a->betas.empty() ? "" : " --betas " + a->betas);
+                      (a->betas.empty() ? "" : " --betas " + a->betas);
     for (size_t i = 0; i < a->scenes.size(); ++i) a->command_line += (i ? "," : " --scenes ") + a->scenes[i];
     char extra[160];
     std::snprintf(extra, sizeof extra, "%s%s%s", a->no_patch ? " --no-patch" : "",

@@ -124,8 +124,9 @@ Site calf_site(const Avatar& a) {
 
 std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
   require(o.pressed_radius > 0 && o.impact_radius > 0 && o.impact_speed > 0 && o.pressed_depth > 0 &&
-              o.impact_depth > 0 && o.pressed_dt > 0 && o.impact_dt > 0 && o.stiffness > 0 && o.newton_iters >= 1,
-          "bench-contact: radii, depths, speed, time steps, stiffness and Newton iterations must be positive");
+              o.impact_depth > 0 && o.pressed_dt > 0 && o.impact_dt > 0 && o.newton_iters >= 1,
+          "bench-contact: radii, depths, speed, time steps and Newton iterations must be positive");
+  check_contact_sampling(o.pressure_stiffness, o.spacing, "bench-contact");
   std::vector<Scene> scenes;
   {
     const double ramp = o.quick ? 0.25 : 0.5, total = o.quick ? 0.35 : 1.0, start = 0.01, depth = o.pressed_depth;
@@ -167,11 +168,12 @@ Trace run_full(std::shared_ptr<const Avatar> avatar, const Scene& sc, const Site
   fo.gravity = Vec3::Zero();
   fo.gradient_tolerance = 1e-6;  // as `sflsh bench`'s reference: far below the errors reported
   FullFem fem(avatar, fo);
-  // The reference samples the skin's faces with the default pressure stiffness
-  // (κ = 1e8 N/m³ ≈ the per-vertex 2e4 N/m over ~1.4e-4 m² of skin per vertex).
+  // The same contact as the reduced solver's: the skin's faces, pressure stiffness κ.
   FullFemObstacle ob;
   ob.name = kObject;
   ob.field = std::make_shared<geometry::SphereSdf>(sc.radius);
+  ob.pressure_stiffness = o.pressure_stiffness;
+  ob.spacing = o.spacing;
   fem.add_obstacle(ob);
   Trace tr;
   Progress p("bench-contact: full FEM, " + sc.name, sc.steps);

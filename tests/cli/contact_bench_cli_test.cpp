@@ -20,8 +20,11 @@ TEST(ContactBenchCli, BadInputFailsWithOneClearLineAndNoOutput) {
       {"bench-contact --handles 0" + out, {"--handles", "1 to 4096"}},
       {"bench-contact --handles 32,x" + out, {"--handles"}},
       {"bench-contact --newton-iters 0" + out, {"--newton-iters", ">= 1"}},
-      {"bench-contact --stiffness -5" + out, {"--stiffness", "positive"}},
-      {"bench-contact --stiffness nan" + out, {"--stiffness", "positive"}},
+      {"bench-contact --pressure-stiffness -5" + out, {"--pressure-stiffness", "pressure stiffness -5"}},
+      {"bench-contact --pressure-stiffness nan" + out, {"--pressure-stiffness", "pressure stiffness nan"}},
+      {"bench-contact --spacing 0" + out, {"--spacing", "spacing 0"}},
+      {"bench-contact --patch-radius 0" + out, {"--patch-radius", "positive"}},
+      {"bench-contact --patch-radius nan" + out, {"--patch-radius", "positive"}},
       {"bench-contact --out " + dir.file("plain_file"), {"--out", "plain_file", "not a folder"}},
   };
   for (const auto& c : cases) {

@@ -66,8 +66,9 @@ struct ContactBenchSettings {
   /// tet's own volume change, as the full-FEM reference integrates it).
   bool mean_dilatation = SoftTissueOptions().mean_dilatation;
   double probe_report_depth = 0.01;  ///< m: force_err is taken there
-  /// The reduced solver's contact (sim/energies/contact_patch.hpp): pressure
-  /// stiffness κ (N/m³), face sample spacing (m), and the full-space patch.
+  /// Contact in both solvers: pressure stiffness κ (N/m³) and face sample
+  /// spacing (m), skin_face_samples.hpp; the reduced solver's full-space patch
+  /// (sim/energies/contact_patch.hpp).
   double pressure_stiffness = kDefaultPressureStiffness;
   double spacing = kDefaultContactSpacing;
   bool patch = true;
