@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <tuple>
 
 #include "sflsh/core/error.hpp"
@@ -135,6 +136,26 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     materials_.emplace_back(m, tet_frame(a, t));
     for (int c = 0; c < 4; ++c) node_mass_[a.tet.elements(t, c)] += m.density * tet_volume_[t] / 4.0;
   }
+  // Broad phase: vertices by dominant bone and 10 cm cell (unposed), each
+  // cluster with a bounding radius and 5 cm of slack for skinning blends and
+  // soft displacement (as sdf_contact.hpp's clusters).
+  std::map<std::tuple<int, long, long, long>, std::vector<int>> cells;
+  for (int v = 0; v < vertices_.size(); ++v) {
+    const Vec3 x = vertices_.unposed().row(v).transpose();
+    cells[{std::max(0, vertices_.dominant_bone(v)), std::lround(std::floor(x.x() / 0.1)),
+           std::lround(std::floor(x.y() / 0.1)), std::lround(std::floor(x.z() / 0.1))}]
+        .push_back(v);
+  }
+  for (auto& [key, members] : cells) {
+    VertexCluster cl;
+    cl.bone = std::get<0>(key);
+    for (int v : members) cl.center += vertices_.unposed().row(v).transpose();
+    cl.center /= double(members.size());
+    for (int v : members) cl.radius = std::max(cl.radius, (vertices_.unposed().row(v).transpose() - cl.center).norm());
+    cl.radius += 0.05;
+    cl.vertices = std::move(members);
+    clusters_.push_back(std::move(cl));
+  }
   vertex_faces_.assign(a.surface_rest.rows(), {});
   for (int f = 0; f < a.surface_faces.rows(); ++f)
     for (int i = 0; i < 3; ++i) vertex_faces_[a.surface_faces(f, i)].push_back(f);
@@ -179,16 +200,33 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
   std::vector<int> near;
   std::vector<double> near_phi;  // φ of each near vertex at t
-  for (int v = 0; v < vertices_.size(); ++v) {
-    const Vec3 x = vertices_.world_point(v, qt);
-    const double motion = has_prev ? 2 * (x - vertices_.world_point(v, *b.q_prev2)).norm() : 0.0;
-    const double reach = options_.margin + motion + object_motion;
-    if (bounded) {
-      const Vec3 lo = box.min.array() - reach, hi = box.max.array() + reach;
-      if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+  for (const VertexCluster& cl : clusters_) {
+    // A cluster whose centre, carried by its bone, is farther from the object
+    // than its radius (slack included) plus the reach holds no near vertex.
+    const Vec3 xc = qt.bones[cl.bone] * cl.center;
+    const double motion_c = has_prev ? 2 * (xc - b.q_prev2->bones[cl.bone] * cl.center).norm() : 0.0;
+    if (field_->distance(T_inv * xc) > cl.radius + options_.margin + motion_c + object_motion) continue;
+    for (int v : cl.vertices) {
+      const Vec3 x = vertices_.world_point(v, qt);
+      const double motion = has_prev ? 2 * (x - vertices_.world_point(v, *b.q_prev2)).norm() : 0.0;
+      const double reach = options_.margin + motion + object_motion;
+      if (bounded) {
+        const Vec3 lo = box.min.array() - reach, hi = box.max.array() + reach;
+        if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+      }
+      const double phi = field_->distance(T_inv * x);
+      if (phi < reach) near.push_back(v), near_phi.push_back(phi);
     }
-    const double phi = field_->distance(T_inv * x);
-    if (phi < reach) near.push_back(v), near_phi.push_back(phi);
+  }
+  std::vector<size_t> order(near.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) { return near[i] < near[j]; });
+  {
+    std::vector<int> n2;
+    std::vector<double> p2;
+    for (size_t i : order) n2.push_back(near[i]), p2.push_back(near_phi[i]);
+    near.swap(n2);
+    near_phi.swap(p2);
   }
   // Candidate faces and their samples.
   std::vector<char> face_mark(a.surface_faces.rows(), 0);

@@ -126,6 +126,13 @@ class ContactPatchTerm : public EnergyTerm {
   std::vector<MaterialPoint> materials_;
   std::vector<std::vector<int>> node_tets_;    // tets of each node
   std::vector<std::vector<int>> vertex_faces_;  // skin faces of each vertex
+  struct VertexCluster {
+    int bone = 0;
+    Vec3 center = Vec3::Zero();  // unposed, m
+    double radius = 0;           // m, slack included
+    std::vector<int> vertices;
+  };
+  std::vector<VertexCluster> clusters_;
 };
 
 /// #V by 3 soft displacement (m, unposed) that the patches of `report` add
