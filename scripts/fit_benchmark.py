@@ -199,10 +199,10 @@ def main():
 
 def judge_logs(work):
     """The known-truth cases' tables from the fit logs in `work`; exit status 0 or EXIT_MISSED."""
+    paths = {name: os.path.join(work, f"fit_{name}.log") for name in ["jump", "cmu"]}
+    cases = {name: parse_fit(read_text(path), path) for name, path in paths.items()}  # every log read before output
     missed = []
-    for name in ["jump", "cmu"]:
-        path = os.path.join(work, f"fit_{name}.log")
-        d = parse_fit(read_text(path), path)
+    for name, d in cases.items():
         print(f"## {name}\n\n{table(d)}\n")
         missed += missed_targets(name, d)
     return report_missed(missed)

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,8 @@ struct Case {
   int exit_code;        ///< 0 met, 1 a target missed, 2 bad input
   std::vector<std::string> fragments;  ///< in the output (stderr for 1 and 2)
 };
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.kind << " " << c.variant; }
 
 std::string check_command(const std::string& kind, const std::string& dir) {
   const std::string scripts = test::source_dir() + "/scripts/";
