@@ -159,7 +159,7 @@ TEST(StressChecks, InvertedIncompleteAndOffTrackRunsFail) {
 
 TEST(StressChecks, SuiteCasesCarryTheirStatedLimits) {
   EXPECT_EQ(stress_case_limits("shake").max_damped_per_step, 0.01);
-  EXPECT_EQ(stress_case_limits("torture").max_damped_per_step, 1.0);
+  EXPECT_EQ(stress_case_limits("torture").max_damped_per_step, 2.0);
   EXPECT_EQ(stress_case_limits("cmu_3x").max_damped_per_step, 1.0);
   EXPECT_EQ(stress_case_limits("fall_on_floor").max_penetration_mm, 5.0);
   EXPECT_EQ(stress_case_limits("box_press").max_penetration_mm, 10.0);
