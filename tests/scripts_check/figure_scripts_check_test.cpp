@@ -37,6 +37,8 @@ std::string check_command(const std::string& kind, const std::string& dir) {
   if (kind == "teleop") return std::string(kPython) + " " + scripts + "teleop_figures.py --check " + dir;
   if (kind == "contact") return std::string(kPython) + " " + scripts + "contact_figures.py --check " + dir;
   if (kind == "fit") return std::string(kPython) + " " + scripts + "fit_benchmark.py --check " + dir;
+  if (kind == "batch_benchmark")
+    return std::string(kPython) + " " + scripts + "batch_benchmark.py --check " + dir + "/checks.json";
   return "bash " + scripts + "batch_resume_check.sh --check " + dir + "/figures.txt";
 }
 
@@ -117,7 +119,13 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"batch_resume", "not_identical", 1, {"5 of 6 files bit-identical"}},
         Case{"batch_resume", "rebuilt_done_rows", 1, {"the rerun kept 0 rows, 2 were done before the kill"}},
         Case{"batch_resume", "missing_key", 2, {"figures.txt: key 'identical' missing"}},
-        Case{"batch_resume", "malformed_value", 2, {"figures.txt: key 'rerun_built': 'four' is not a count"}}),
+        Case{"batch_resume", "malformed_value", 2, {"figures.txt: key 'rerun_built': 'four' is not a count"}},
+        Case{"batch_benchmark", "good", 0, {"batch_benchmark: passed"}},
+        Case{"batch_benchmark", "jobs2_differs", 1, {"jobs2 wrote files different from serial's: avatar-0000000000000002.h5"}},
+        Case{"batch_benchmark", "dask1_built_fewer", 1, {"dask1 built 3 of 4 shapes"}},
+        Case{"batch_benchmark", "template_rewritten", 1, {"the template cache entry was rewritten"}},
+        Case{"batch_benchmark", "missing_field", 2, {"checks.json: field 'template_cache_rewritten' missing"}},
+        Case{"batch_benchmark", "malformed", 2, {"checks.json: not JSON"}}),
     name_of);
 
 }  // namespace

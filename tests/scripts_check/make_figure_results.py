@@ -3,7 +3,7 @@
 
   make_figure_results.py KIND VARIANT DIR
 
-KIND: teleop | contact | fit | batch_resume. VARIANT "good" writes files that
+KIND: teleop | contact | fit | batch_resume | batch_benchmark. VARIANT "good" writes files that
 meet every target the script states (values near the recorded figures);
 every other variant is "good" with one defect (see VARIANTS), either a missed
 target (the script must exit 1) or a missing/malformed file, column or line
@@ -213,7 +213,24 @@ def batch_resume(variant, d):
     write(os.path.join(d, "figures.txt"), text)
 
 
-KINDS = {"teleop": teleop, "contact": contact, "fit": fit, "batch_resume": batch_resume}
+def batch_benchmark(variant, d):
+    files = {f"avatar-{k:016x}.h5": f"{k:064x}" for k in range(4)}
+    ways = {way: {"built": 4, "files": dict(files)} for way in ("serial", "jobs2", "dask1")}
+    if variant == "jobs2_differs":
+        ways["jobs2"]["files"]["avatar-0000000000000002.h5"] = "f" * 64
+    if variant == "dask1_built_fewer":
+        ways["dask1"]["built"] = 3
+    c = {"shapes": 4, "ways": ways, "template_cache_rewritten": variant == "template_rewritten"}
+    if variant == "missing_field":
+        del c["template_cache_rewritten"]
+    text = json.dumps(c)
+    if variant == "malformed":
+        text = text[:-5]
+    write(os.path.join(d, "checks.json"), text)
+
+
+KINDS = {"teleop": teleop, "contact": contact, "fit": fit, "batch_resume": batch_resume,
+         "batch_benchmark": batch_benchmark}
 
 
 def main():
