@@ -36,7 +36,7 @@ std::string StressReport::failure() const {
   }
   if (!stable) {
     o << "soft displacement grew (" << (short_run ? "last tenth of the steps " : "last window ") << peak_soft_mm_late
-      << " mm, " << (short_run ? "every step before " : "first 10 % ") << peak_soft_mm_early << " mm)";
+      << " mm, " << (short_run ? "every step before " : "first windows ") << peak_soft_mm_early << " mm)";
     return o.str();
   }
   return "";
@@ -53,7 +53,7 @@ std::string StressReport::describe() const {
     << "  rejected / damped:       " << rejected << " (at most " << max_rejected << ") / " << damped << " (at most "
     << max_damped_per_step << " per step)" << (few_rejected ? "" : "  (TOO MANY REJECTED)")
     << (few_damped ? "" : "  (TOO MANY DAMPED)") << "\n"
-    << "  peak soft displacement:  " << (short_run ? "steps before the last tenth " : "first 10 % ")
+    << "  peak soft displacement:  " << (short_run ? "steps before the last tenth " : "first windows ")
     << peak_soft_mm_early << " mm, " << (short_run ? "last tenth " : "last window ") << peak_soft_mm_late << " mm"
     << (stable ? "" : "  (GROWING)") << "\n"
     << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm
@@ -78,8 +78,10 @@ void judge_stress(StressReport& r, const StressOptions& o) {
     for (size_t i = 0; i + late < p.size(); ++i) r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, p[i]);
     for (size_t i = p.size() - late; i < p.size(); ++i) r.peak_soft_mm_late = std::max(r.peak_soft_mm_late, p[i]);
   } else {
-    // The last window against the first 10 % of the windows (one window, a one-step run: itself).
-    const size_t early = std::max<size_t>(1, r.windows.size() / 10);
+    // The last window against the first 10 % (growth_reference_share, rounded up) of the windows (one window, a
+    // one-step run: itself).
+    const size_t early =
+        std::max<size_t>(1, size_t(std::ceil(double(r.windows.size()) * o.growth_reference_share - 1e-9)));
     for (size_t i = 0; i < std::min(early, r.windows.size()); ++i)
       r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
     if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;

@@ -100,7 +100,18 @@ TEST(StressChecks, LongRunComparesTheLastWindowWithTheFirstTenth) {
   StressReport grown = crafted_run(p, 100);
   judge_stress(grown, options());
   EXPECT_FALSE(grown.stable);
-  EXPECT_NE(grown.failure().find("last window 35.0 mm, first 10 % 20.0 mm"), std::string::npos) << grown.failure();
+  EXPECT_NE(grown.failure().find("last window 35.0 mm, first windows 20.0 mm"), std::string::npos) << grown.failure();
+  // A scene's reference is its first half (growth_reference_share 0.5): a body that tips over at 40 % of the
+  // run and then lies still (20 -> 33 mm, like fall_on_floor) passes; with the first 10 % it would not.
+  p.assign(2000, 20.0);
+  for (int i = 800; i < 2000; ++i) p[size_t(i)] = 33.0;
+  StressReport tipped = crafted_run(p, 100);
+  StressOptions scene = options();
+  scene.growth_reference_share = 0.5;
+  judge_stress(tipped, scene);
+  EXPECT_TRUE(tipped.stable) << tipped.failure();
+  judge_stress(tipped, options());
+  EXPECT_FALSE(tipped.stable);
   // A NaN peak fails instead of passing every comparison.
   p.assign(2000, 20.0);
   p.back() = std::numeric_limits<double>::quiet_NaN();
