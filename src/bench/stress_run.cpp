@@ -36,7 +36,8 @@ std::string StressReport::failure() const {
   }
   if (!stable) {
     o << "soft displacement grew (" << (short_run ? "last tenth of the steps " : "last window ") << peak_soft_mm_late
-      << " mm, " << (short_run ? "every step before " : "first windows ") << peak_soft_mm_early << " mm)";
+      << " mm, " << (short_run ? "every step before " : "first windows ") << peak_soft_mm_early << " mm; at most "
+      << growth_limit << "x)";
     return o.str();
   }
   return "";
@@ -55,7 +56,7 @@ std::string StressReport::describe() const {
     << (few_damped ? "" : "  (TOO MANY DAMPED)") << "\n"
     << "  peak soft displacement:  " << (short_run ? "steps before the last tenth " : "first windows ")
     << peak_soft_mm_early << " mm, " << (short_run ? "last tenth " : "last window ") << peak_soft_mm_late << " mm"
-    << (stable ? "" : "  (GROWING)") << "\n"
+    << " (at most " << growth_limit << "x)" << (stable ? "" : "  (GROWING)") << "\n"
     << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm
     << " mm (every step)" << (tracking ? "" : "  (OVER THE TOLERANCE)") << "\n"
     << "  result: " << (passed() ? "PASSED" : "FAILED") << "\n";
@@ -89,7 +90,8 @@ void judge_stress(StressReport& r, const StressOptions& o) {
   // Written so that NaN figures fail.
   r.no_inversion = r.min_det > 0;
   r.complete = r.steps == r.planned_steps;
-  r.stable = r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
+  r.growth_limit = r.short_run ? o.short_run_growth_limit : o.growth_limit;
+  r.stable = r.peak_soft_mm_late <= r.growth_limit * r.peak_soft_mm_early;
   r.tracking = o.pelvis_tolerance_mm <= 0 || r.pelvis_error_max_mm <= o.pelvis_tolerance_mm;
   r.max_rejected = o.max_rejected;
   r.max_damped_per_step = o.max_damped_per_step;
