@@ -22,8 +22,9 @@
 //
 // A case passes when its state stays finite, it runs every planned step, no
 // cubature sample inverts (det F > 0), the soft displacement does not grow
-// (StressOptions::growth_limit; scenes: per output frame, one per window or,
-// in a run shorter than two windows, one per step),
+// (StressOptions::growth_limit, short_run_growth_limit in a run shorter than
+// two windows; scenes: per output frame, one per window or, in a run shorter
+// than two windows, one per step),
 // the pelvis stays within 20 mm of the motion's root (motion cases), and it
 // stays within its limits (stress_case_limits): rejected steps, damped Newton
 // iterations per step and, for the scenes, the deepest penetration of any
@@ -57,10 +58,10 @@ struct StressCaseLimits {
 ///   fall_on_floor  0 rejected, ≤ 1 damped per step (the damped iterations come with
 ///                  the landing, so their share depends on the run's length: 0.013–0.061
 ///                  over 10⁴ steps, 0.15 over 600 on a coarse body), penetration ≤ 5 mm
-///                  (scripts/contact_figures.py's target; recorded 4.2 mm)
+///                  (scripts/contact_figures.py's target; recorded 3.85–4.2 mm)
 ///   box_press      0 rejected, ≤ 1 damped per step (recorded ≤ 0.002 over 10⁴ steps,
 ///                  0.04 over 600), penetration ≤ 10 mm (the box goes 20 mm into the
-///                  belly; recorded 4.75 mm)
+///                  belly; recorded 4.75–4.84 mm)
 /// Throws sflsh::Error for an unknown name.
 StressCaseLimits stress_case_limits(const std::string& name);
 
