@@ -11,12 +11,21 @@ cached once beforehand:
 Writes scripts/results/batch_benchmark.csv (one line per way), the manifests
 (batch_manifest_<way>.csv) and batch_benchmark.md. Also checks that the four
 ways wrote bit-identical files and that the template cache entry was not rebuilt.
+The checks' figures (per way: shapes built and each file's SHA-256; whether
+the template cache entry was rewritten) go to batch_benchmark_checks.json and
+are judged from that file alone: `--check FILE` re-judges one. Exit status: 0
+when every way built every shape, the ways' files are bit-identical and the
+template cache entry was not rewritten (the .md is written either way); 1
+otherwise (named on stderr); 2 when the checks file is missing or malformed
+(one line naming the file and the field).
 
 Usage: /usr/bin/python3 scripts/batch_benchmark.py [--sflsh build/sflsh] [--shapes 16] [--handles 16]
+       /usr/bin/python3 scripts/batch_benchmark.py --check scripts/results/batch_benchmark_checks.json
 """
 import argparse
 import csv
-import filecmp
+import hashlib
+import json
 import os
 import random
 import resource
@@ -27,6 +36,8 @@ import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from figure_check import EXIT_BAD_INPUT, EXIT_MISSED, BadResults, read_text  # noqa: E402
 
 
 def children_cpu():
@@ -39,7 +50,64 @@ def load():
         return float(f.read().split()[0])
 
 
+def sha256(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def judge_checks(path):
+    """The failed checks (list of strings) of a batch_benchmark_checks JSON file; BadResults if malformed."""
+    try:
+        c = json.loads(read_text(path))
+    except json.JSONDecodeError as e:
+        raise BadResults(f"{path}: not JSON ({e.msg} at line {e.lineno})") from None
+    if not isinstance(c, dict):
+        raise BadResults(f"{path}: expected an object")
+    for key, kind in (("shapes", int), ("template_cache_rewritten", bool), ("ways", dict)):
+        if not isinstance(c.get(key), kind):
+            raise BadResults(f"{path}: field '{key}' missing or not {kind.__name__}")
+    if not c["ways"]:
+        raise BadResults(f"{path}: field 'ways' is empty")
+    failures = []
+    reference = None
+    for way, w in c["ways"].items():
+        if not isinstance(w, dict) or not isinstance(w.get("built"), int) or not isinstance(w.get("files"), dict):
+            raise BadResults(f"{path}: ways.{way}: expected {{\"built\": N, \"files\": {{name: sha256}}}}")
+        if w["built"] != c["shapes"]:
+            failures.append(f"{way} built {w['built']} of {c['shapes']} shapes")
+        if reference is None:
+            reference = (way, w["files"])
+        elif w["files"] != reference[1]:
+            names = sorted(set(w["files"]) | set(reference[1]))
+            differ = [n for n in names if w["files"].get(n) != reference[1].get(n)]
+            failures.append(f"{way} wrote files different from {reference[0]}'s: {', '.join(differ[:3])}"
+                            + (f" and {len(differ) - 3} more" if len(differ) > 3 else ""))
+    if c["template_cache_rewritten"]:
+        failures.append("the template cache entry was rewritten during the runs")
+    return failures
+
+
+def report(failures):
+    for f in failures:
+        print("batch_benchmark: FAILED: " + f, file=sys.stderr)
+    return EXIT_MISSED if failures else 0
+
+
 def main():
+    if sys.argv[1:2] == ["--check"]:
+        if len(sys.argv) != 3:
+            sys.exit("usage: batch_benchmark.py --check CHECKS.json")
+        try:
+            failures = judge_checks(sys.argv[2])
+        except BadResults as e:
+            print(f"batch_benchmark: {e}", file=sys.stderr)
+            sys.exit(EXIT_BAD_INPUT)
+        if not failures:
+            print("batch_benchmark: passed")
+        sys.exit(report(failures))
     ap = argparse.ArgumentParser()
     ap.add_argument("--sflsh", default=os.path.join(ROOT, "build", "sflsh"))
     ap.add_argument("--shapes", type=int, default=16)
@@ -64,7 +132,7 @@ def main():
     print("template stage:", t.stdout.strip(), file=sys.stderr)
 
     rows = []
-    dirs = {}
+    checks = {"shapes": args.shapes, "ways": {}}
     for way in args.ways.split(","):
         out_dir = os.path.join(work, way)
         if way in ("serial", "serial1", "jobs2"):
@@ -85,9 +153,11 @@ def main():
             sys.exit("%s failed:\n%s%s" % (way, p.stdout, p.stderr))
         with open(manifest) as f:
             m = list(csv.DictReader(f))
-        built = [r for r in m if r["status"] == "built"]
-        assert len(built) == args.shapes, (way, len(built))
-        dirs[way] = out_dir
+        built = [r for r in m if r.get("status") == "built"]
+        checks["ways"][way] = {"built": len(built), "files": {n: sha256(os.path.join(out_dir, n))
+                                                              for n in sorted(os.listdir(out_dir)) if n.endswith(".h5")}}
+        if not built:
+            continue
         summary = [l for l in p.stdout.splitlines() if l.startswith("summary:") or l.startswith("batch summary:")]
         row = {"way": way, "shapes": args.shapes, "handles": args.handles, "wall_s": round(wall, 2),
                "wall_per_shape_s": round(wall / args.shapes, 2), "cpu_s": round(cpu, 2),
@@ -100,11 +170,15 @@ def main():
         shutil.copy(manifest, os.path.join(args.out, "batch_manifest_%s%s.csv" % (way, args.suffix)))
         print(row, file=sys.stderr)
 
-    rebuilt = os.stat(cache).st_mtime_ns != cache_mtime
-    base = rows[0]["way"]
-    names = sorted(n for n in os.listdir(dirs[base]) if n.endswith(".h5"))
-    identical = all(filecmp.cmp(os.path.join(dirs[base], n), os.path.join(dirs[w], n), shallow=False)
-                    for w in dirs for n in names)
+    checks["template_cache_rewritten"] = os.stat(cache).st_mtime_ns != cache_mtime
+    checks_path = os.path.join(args.out, "batch_benchmark_checks%s.json" % args.suffix)
+    with open(checks_path, "w") as f:
+        json.dump(checks, f, indent=1)
+    failures = judge_checks(checks_path)
+    if not rows:
+        sys.exit(report(failures) or EXIT_MISSED)
+    rebuilt = checks["template_cache_rewritten"]
+    identical = not any("different" in f for f in failures)
     by = {r["way"]: r for r in rows}
     for r in rows:
         ref = by.get("serial", r) if r["way"] in ("serial", "serial1", "jobs2") else by.get("dask1", r)
@@ -142,6 +216,7 @@ def main():
                 f.write("\n%s: `%s`\n" % (r["way"], r["summary"]))
     shutil.rmtree(work, ignore_errors=True)
     print(open(os.path.join(args.out, "batch_benchmark%s.md" % args.suffix)).read())
+    sys.exit(report(failures))
 
 
 if __name__ == "__main__":

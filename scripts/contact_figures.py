@@ -2,12 +2,17 @@
 """Issue 10's contact figures on the built-in avatar.
 
 Runs the example scenes (apps/scenes/*.yaml) and the figure scenes
-(apps/scenes/figures/*.yaml) with `sflsh simulate`, reads what each run
-prints (per-pair contact figures, step counts, momentum) and the result
-files, and writes a Markdown table of the figures against the issue's
-targets to stdout (scripts/results/contact_figures.md keeps the last one).
+(apps/scenes/figures/*.yaml) with `sflsh simulate`, keeps each run's output
+(NAME.log) and result file (NAME.h5) in WORK_DIR, and judges the figures
+against the issue's targets from those files alone (judge()), so that
+`--check WORK_DIR` re-judges a finished run without simulating. Writes a
+Markdown table to stdout (scripts/results/contact_figures.md keeps the last
+one). Exit status: 0 when every stated target is met, 1 when one is missed
+(named on stderr), 2 when a result file is missing or malformed (one line
+naming the file and the dataset or log line).
 
 Usage: /usr/bin/python3 scripts/contact_figures.py [WORK_DIR]   (default out/contact_figures)
+       /usr/bin/python3 scripts/contact_figures.py --check WORK_DIR
 The avatar is precomputed into WORK_DIR/avatar.h5 unless it is there already.
 """
 import os
@@ -17,42 +22,28 @@ import subprocess
 import sys
 import time
 
-import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_check import BadResults, FigureTable, h5_dataset, read_text, run_judged, search  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SFLSH = os.path.join(ROOT, os.environ.get("SFLSH_BUILD_DIR", "build"), "sflsh")
+SCRIPT = "contact_figures"
 G = 9.81
+# The floor's force on the body at rest: its horizontal part at most this share of the vertical one.
+FLOOR_HORIZONTAL_SHARE = 0.02
+# The scenes judge() reads (NAME.log and, where used, NAME.h5).
+JUDGED = ["slab_on_belly", "sphere_on_belly", "fall_on_floor", "two_walkers", "momentum_bump", "pinch_from_file",
+          "ball_at_belly", "box_press"]
 
 
-def run(args, cwd):
-    t = time.time()
-    p = subprocess.run(args, cwd=cwd, capture_output=True, text=True)
-    if p.returncode != 0:
-        sys.exit(f"{' '.join(args)} failed:\n{p.stdout}\n{p.stderr}")
-    return p.stdout, time.time() - t
-
-
-def contact_lines(log):
-    """{(term, body): (max penetration mm, max force N, end force vector N)}"""
-    out = {}
-    for m in re.finditer(r"contact (\S+) on (\S+): max penetration ([\d.]+) mm, max force ([\d.]+) N, in contact "
-                         r"(\d+) steps; at the end\s+(\S+)\s+(\S+)\s+(\S+) N", log):
-        out[(m[1], m[2])] = (float(m[3]), float(m[4]), np.array([float(m[6]), float(m[7]), float(m[8])]))
-    return out
-
-
-def steps_line(log):
-    m = re.search(r"steps: (\d+) accepted, (\d+) damped, (\d+) rejected; step time median ([\d.]+) ms", log)
-    return int(m[1]), int(m[2]), int(m[3]), float(m[4])
-
-
-def main():
-    work = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "out", "contact_figures"))
-    os.makedirs(work, exist_ok=True)
+def measure(work):
+    """Runs every scene; leaves NAME.log (stdout, then a line 'wall seconds: S') and NAME.h5 in `work`."""
     if not os.path.exists(os.path.join(work, "avatar.h5")):
-        run([SFLSH, "precompute", "--out", "avatar.h5"], work)
-    scenes = {}
+        p = subprocess.run([SFLSH, "precompute", "--out", "avatar.h5"], cwd=work, capture_output=True, text=True)
+        if p.returncode != 0:
+            sys.exit(f"sflsh precompute failed:\n{p.stdout}\n{p.stderr}")
     for folder in ("apps/scenes", "apps/scenes/figures"):
         for f in sorted(os.listdir(os.path.join(ROOT, folder))):
             if f.endswith(".csv"):
@@ -60,61 +51,104 @@ def main():
         for f in sorted(os.listdir(os.path.join(ROOT, folder))):
             if f.endswith(".yaml"):
                 shutil.copy(os.path.join(ROOT, folder, f), work)
-                log, secs = run([SFLSH, "simulate", f], work)
-                scenes[f[:-5]] = (log, secs)
+                t = time.time()
+                p = subprocess.run([SFLSH, "simulate", f], cwd=work, capture_output=True, text=True)
+                if p.returncode != 0:
+                    sys.exit(f"sflsh simulate {f} failed:\n{p.stdout}\n{p.stderr}")
+                secs = time.time() - t
+                with open(os.path.join(work, f[:-5] + ".log"), "w") as out:
+                    out.write(p.stdout + f"wall seconds: {secs:.1f}\n")
                 print(f"ran {f} in {secs:.1f} s", file=sys.stderr)
 
-    rows = []
 
-    def row(figure, target, value, ok, scene):
-        rows.append(f"| {figure} | {target} | {value} | {'yes' if ok else '**no**'} | `{scene}` |")
+def contact_lines(log):
+    """{(term, body): (max penetration mm, max force N, end force vector N)}"""
+    out = {}
+    for m in re.finditer(r"contact (\S+) on (\S+): max penetration ([\d.]+) mm, max force ([\d.]+) N, in contact "
+                         r"(\d+) steps; at the end\s+(\S+)\s+(\S+)\s+(\S+) N", log):
+        try:
+            end = np.array([float(m[6]), float(m[7]), float(m[8])])
+        except ValueError:
+            end = np.full(3, np.nan)
+        out[(m[1], m[2])] = (float(m[3]), float(m[4]), end)
+    return out
+
+
+def contact(log, path, term, body):
+    c = contact_lines(log).get((term, body))
+    if c is None:
+        raise BadResults(f"{path}: no 'contact {term} on {body}: max penetration ...' line")
+    return c
+
+
+def steps_line(log, path):
+    m = search(r"steps: (\d+) accepted, (\d+) damped, (\d+) rejected; step time median ([\d.]+) ms", log, path,
+               "'steps: N accepted, N damped, N rejected; step time median ...'")
+    return int(m[1]), int(m[2]), int(m[3]), float(m[4])
+
+
+def judge(work):
+    """The figures and verdicts from the files in `work` -> (Markdown text, FigureTable)."""
+    w = lambda name: os.path.join(work, name)  # noqa: E731
+    logs = {name: read_text(w(name + ".log")) for name in JUDGED}
+    table = FigureTable()
+    row = table.row
 
     # Static equilibrium: contact force = weight.
-    log = scenes["slab_on_belly"][0]
-    f = contact_lines(log)[("contact:slab", "alice")][2]
+    f = contact(logs["slab_on_belly"], w("slab_on_belly.log"), "contact:slab", "alice")[2]
     ratio = abs(f[2]) / (2.0 * G)
     row("slab (2 kg) resting on the belly: contact force / weight", "1 ± 0.02", f"{ratio:.4f}", abs(ratio - 1) <= 0.02,
         "figures/slab_on_belly.yaml")
-    log = scenes["sphere_on_belly"][0]
-    f = contact_lines(log)[("contact:ball", "alice")][2]
-    with h5py.File(os.path.join(work, "sphere_on_belly.h5")) as h:
-        p = h["/frames/object_poses"][:, 0, :3]
-        t = h["/frames/time"][:]
+    f = contact(logs["sphere_on_belly"], w("sphere_on_belly.log"), "contact:ball", "alice")[2]
+    poses = h5_dataset(w("sphere_on_belly.h5"), "/frames/object_poses")
+    t = h5_dataset(w("sphere_on_belly.h5"), "/frames/time")
+    if poses.ndim != 3 or poses.shape[0] < 2 or poses.shape[2] < 3 or t.shape[0] != poses.shape[0]:
+        raise BadResults(f"{w('sphere_on_belly.h5')}: dataset '/frames/object_poses' has shape {poses.shape}, "
+                         f"expected (frames >= 2, objects, 7) with as many frames as '/frames/time' ({t.shape[0]})")
+    p = poses[:, 0, :3]
     v = np.linalg.norm(p[-1] - p[-2]) / (t[-1] - t[-2])
     ratio = abs(f[2]) / (1.0 * G)
     row(f"sphere (1 kg) on the belly at t = {t[-1]:.1f} s (speed {v * 1e3:.0f} mm/s): force / weight", "1 ± 0.02",
         f"{ratio:.4f}", abs(ratio - 1) <= 0.02, "figures/sphere_on_belly.yaml")
     # Floor drop.
-    log = scenes["fall_on_floor"][0]
-    pen, _, fend = contact_lines(log)[("contact:floor", "alice")]
-    acc, damped, rej, _ = steps_line(log)
-    with h5py.File(os.path.join(work, "fall_on_floor.h5")) as h:
-        finite = bool(np.isfinite(h["/frames/positions"][:]).all())
+    log, path = logs["fall_on_floor"], w("fall_on_floor.log")
+    pen, _, fend = contact(log, path, "contact:floor", "alice")
+    acc, damped, rej, _ = steps_line(log, path)
+    finite = bool(np.isfinite(h5_dataset(w("fall_on_floor.h5"), "/frames/positions")).all())
     row("avatar dropped 0.4 m on the floor: max penetration", "≤ 5 mm", f"{pen:.2f} mm", pen <= 5,
         "fall_on_floor.yaml")
     row("  … rejected steps, NaN", "0, none", f"{rej}, {'none' if finite else 'NaN'}", rej == 0 and finite,
         "fall_on_floor.yaml")
-    row("  … floor force at rest (the body's weight)", "vertical", f"{fend[1]:.0f} N up, |horizontal| "
-        f"{np.hypot(fend[0], fend[2]):.1f} N", fend[1] > 0, "fall_on_floor.yaml")
+    horizontal = float(np.hypot(fend[0], fend[2]))
+    row("  … floor force at rest (the body's weight): up, horizontal part / vertical",
+        f"vertical: up, ≤ {FLOOR_HORIZONTAL_SHARE}", f"{fend[1]:.0f} N up, |horizontal| {horizontal:.1f} N "
+        f"({horizontal / fend[1] if fend[1] > 0 else float('nan'):.4f})",
+        fend[1] > 0 and horizontal <= FLOOR_HORIZONTAL_SHARE * fend[1], "fall_on_floor.yaml")
     # Two walkers.
-    log = scenes["two_walkers"][0]
-    ov = contact_lines(log)[("body_contact", "alice")][0]
+    ov = contact(logs["two_walkers"], w("two_walkers.log"), "body_contact", "alice")[0]
     row("two avatars walking into each other: max capsule overlap", "≤ 5 mm", f"{ov:.2f} mm", ov <= 5,
         "two_walkers.yaml")
     # Momentum.
-    log = scenes["momentum_bump"][0]
-    m = re.search(r"linear momentum: start ([\d.]+) kg m/s, end ([\d.]+) kg m/s \(change (\S+)\)", log)
-    rel = float(m[3]) / float(m[1])
+    m = search(r"linear momentum: start ([\d.]+) kg m/s, end ([\d.]+) kg m/s \(change (\S+)\)",
+               logs["momentum_bump"], w("momentum_bump.log"), "'linear momentum: start ... (change ...)'")
+    try:
+        rel = float(m[3]) / float(m[1])
+    except (ValueError, ZeroDivisionError):
+        raise BadResults(f"{w('momentum_bump.log')}: 'linear momentum' line: change {m[3]!r} / start {m[1]!r} "
+                         "is not a ratio of numbers") from None
     row("two-body collision, gravity off: |Δp| / |p|", "≤ 1e-6", f"{rel:.1e}", rel <= 1e-6, "figures/momentum_bump.yaml")
     # Pinch-and-lift from a recorded pose file (issue 11).
-    log = scenes["pinch_from_file"][0]
-    m = re.search(r"tools: peak force ([\d.]+) N, largest anchor stretch ([\d.]+) mm", log)
+    log, path = logs["pinch_from_file"], w("pinch_from_file.log")
+    m = search(r"tools: peak force ([\d.]+) N, largest anchor stretch ([\d.]+) mm", log, path,
+               "'tools: peak force ... largest anchor stretch ...'")
     grasps = len(re.findall(r": grasp (\d+) skin points", log))
     releases = len(re.findall(r": release (\d+) skin points", log))
-    acc, damped, rej, _ = steps_line(log)
-    with h5py.File(os.path.join(work, "pinch_from_file.h5")) as h:
-        finite = bool(np.isfinite(h["/frames/positions"][:]).all())
-        u = h["/frames/displacement"][:]
+    acc, damped, rej, _ = steps_line(log, path)
+    finite = bool(np.isfinite(h5_dataset(w("pinch_from_file.h5"), "/frames/positions")).all())
+    u = h5_dataset(w("pinch_from_file.h5"), "/frames/displacement")
+    if u.ndim != 3 or u.shape[0] <= 6:
+        raise BadResults(f"{w('pinch_from_file.h5')}: dataset '/frames/displacement' has shape {u.shape}, "
+                         "expected (frames > 6, vertices, 3)")
     stretch = float(m[2])
     row("pinch-and-lift 1.5 cm from a pose file: largest anchor stretch (slip)", "≤ 1 mm", f"{stretch:.2f} mm",
         stretch <= 1.0, "figures/pinch_from_file.yaml")
@@ -123,28 +157,41 @@ def main():
         finite, "figures/pinch_from_file.yaml")
     row("  … peak force on the gripper; skin displacement at the end vs before the grasp", "(record)",
         f"{float(m[1]):.0f} N; {np.abs(u[-1]).max() * 1e3:.1f} mm vs {np.abs(u[int(0.2 * 30)]).max() * 1e3:.1f} mm",
-        True, "figures/pinch_from_file.yaml")
+        None, "figures/pinch_from_file.yaml")
     # The other examples, for the record.
     for name, term in (("ball_at_belly", "contact:ball"), ("box_press", "contact:press")):
-        log = scenes[name][0]
-        pen, fmax, _ = contact_lines(log)[(term, "alice")]
-        acc, damped, rej, med = steps_line(log)
-        rows.append(f"| {name}: max penetration, peak force, step median | (record) | {pen:.2f} mm, {fmax:.0f} N, "
-                    f"{med:.2f} ms | | `{name}.yaml` |")
+        pen, fmax, _ = contact(logs[name], w(name + ".log"), term, "alice")
+        acc, damped, rej, med = steps_line(logs[name], w(name + ".log"))
+        row(f"{name}: max penetration, peak force, step median", "(record)", f"{pen:.2f} mm, {fmax:.0f} N, {med:.2f} ms",
+            None, f"{name}.yaml")
 
-    print("# Contact and tool figures (issues 10 and 11)\n")
-    print("Built-in avatar (`sflsh precompute --out avatar.h5`), default contact settings "
-          "(stiffness 2e5 N/m per skin sample, 1e6 N/m per capsule pair, friction 0.5).")
-    print("Reproduce: `/usr/bin/python3 scripts/contact_figures.py` (about two minutes after the build).\n")
-    print("| figure | target | measured | met | scene |")
-    print("|---|---|---|---|---|")
-    print("\n".join(rows))
-    print("\nPer-pair lines as `sflsh simulate` printed them:\n")
-    for name, (log, secs) in scenes.items():
-        print(f"- `{name}` ({secs:.1f} s wall):")
+    text = ["# Contact and tool figures (issues 10 and 11)\n",
+            "Built-in avatar (`sflsh precompute --out avatar.h5`), default contact settings "
+            "(stiffness 2e5 N/m per skin sample, 1e6 N/m per capsule pair, friction 0.5).",
+            "Reproduce: `/usr/bin/python3 scripts/contact_figures.py` (about two minutes after the build; "
+            "`--check WORK_DIR` re-judges its files).\n",
+            table.markdown(), "\nPer-pair lines as `sflsh simulate` printed them:\n"]
+    for name in sorted(f[:-4] for f in os.listdir(work) if f.endswith(".log")):
+        log = logs.get(name) or read_text(w(name + ".log"))
+        wall = re.search(r"^wall seconds: ([\d.]+)", log, re.M)
+        text.append(f"- `{name}`" + (f" ({wall[1]} s wall):" if wall else ":"))
         for line in log.splitlines():
             if line.startswith(("contact ", "steps:", "linear momentum", "mean ms")):
-                print(f"  - {line}")
+                text.append(f"  - {line}")
+    return "\n".join(text), table
+
+
+def main():
+    args = sys.argv[1:]
+    if args[:1] == ["--check"]:
+        if len(args) != 2:
+            sys.exit("usage: contact_figures.py --check WORK_DIR")
+        work = os.path.abspath(args[1])
+    else:
+        work = os.path.abspath(args[0] if args else os.path.join(ROOT, "out", "contact_figures"))
+        os.makedirs(work, exist_ok=True)
+        measure(work)
+    run_judged(SCRIPT, lambda: judge(work))
 
 
 if __name__ == "__main__":

@@ -10,7 +10,14 @@ Cases: builtin jump; CMU 16_46 (BVH); the jump with numeric Jacobians (one
 iteration, for its cost); the jump observed with the full-FEM reference (no
 noise; the model is not the truth).
 
+Targets (known truth, the jump and CMU cases): every fitted Young's factor
+within 5 % of the truth, every Fung c factor within 10 % (`ok` / `MISSED` in
+the tables). Exit status: 0 when every target is met, 1 when one is missed
+(named on stderr; fit.md is written either way), 2 when a fit log is missing or
+malformed (one line naming the file and the line).
+
 Usage: scripts/fit_benchmark.py [--work /tmp/fit] [--skip-fem]
+       scripts/fit_benchmark.py --check WORK   (judges WORK/fit_jump.log and WORK/fit_cmu.log only)
 (build/sflsh must exist; the avatar is precomputed into --work if missing).
 """
 import argparse
@@ -22,8 +29,12 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from figure_check import EXIT_BAD_INPUT, EXIT_MISSED, BadResults, read_text, search  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SFLSH = os.path.join(ROOT, "build", "sflsh")
+YOUNG_TOLERANCE_PCT, FUNG_TOLERANCE_PCT = 5, 10  # the fits' targets (known truth)
 REGIONS = ["torso", "belly", "chest", "buttocks", "thigh", "calf", "upper_arm", "forearm", "neck", "head", "hand", "foot"]
 E = [3e4, 8e3, 1.5e4, 1.2e4, 2e4, 3e4, 2e4, 3e4, 3e4, 1e5, 1e5, 1e5]  # volume/body_regions.cpp defaults
 YOUNG = [0.3, 2.5, 1.6, 0.5, 3.0, 0.7, 1.8, 0.4, 2.0, 1.0, 1.0, 1.0]  # truth / default
@@ -54,7 +65,8 @@ def run(args, log, reuse=False):
     return p.stdout, wall, cpu
 
 
-def parse_fit(out):
+def parse_fit(out, path="the fit log"):
+    """The figures of one `sflsh fit` log (`out`, the contents of `path`); BadResults naming the line if absent."""
     fit = {}
     for m in re.finditer(r"^  (young|fung_c|poisson):(\w+)\s+x([\d.]+)\s+\(start x[\d.]+\)\s+(?:±([\d.e+inf]+%)|1-sigma factor (.*))$",
                          out, re.M):
@@ -62,18 +74,34 @@ def parse_fit(out):
         if m.group(4) and float(m.group(4)[:-1]) > 900:
             sigma = "factor > x10"
         fit[(m.group(1), m.group(2))] = (float(m.group(3)), sigma)
+    if not fit:
+        raise BadResults(f"{path}: no fitted parameter lines ('  young:REGION  xF (start xS) ...')")
     d = {"fit": fit}
-    d["iters"] = int(re.search(r"Iterations: (\d+)", out).group(1))
-    m = re.search(r"surface error RMS per coordinate: ([\d.]+) mm before, ([\d.]+) mm after", out)
+    d["iters"] = int(search(r"Iterations: (\d+)", out, path, "'Iterations: N'").group(1))
+    m = search(r"surface error RMS per coordinate: ([\d.]+) mm before, ([\d.]+) mm after", out, path,
+               "'surface error RMS per coordinate: ... before, ... after'")
     d["rms_before"], d["rms_after"] = float(m.group(1)), float(m.group(2))
-    m = re.search(r"time: ([\d.]+) s wall, ([\d.]+) s CPU; (\d+) iterations", out)
+    m = search(r"time: ([\d.]+) s wall, ([\d.]+) s CPU; (\d+) iterations", out, path, "'time: ... s wall, ... s CPU'")
     d["wall"], d["cpu"] = float(m.group(1)), float(m.group(2))
-    m = re.search(r"([\d.]+) ms per run without, ([\d.]+) ms per Jacobian evaluation; Ceres: (.*)$", out, re.M)
+    m = search(r"([\d.]+) ms per run without, ([\d.]+) ms per Jacobian evaluation; Ceres: (.*)$", out, path,
+               "'... ms per run without, ... ms per Jacobian evaluation'")
     d["ms_run"], d["ms_jac"], d["ceres_times"] = float(m.group(1)), float(m.group(2)), m.group(3)
-    d["stopped"] = re.search(r"^Ceres stopped: (.*)$", out, re.M).group(1)
+    d["stopped"] = search(r"^Ceres stopped: (.*)$", out, path, "'Ceres stopped: ...'").group(1)
     d["warnings"] = re.findall(r"^warning: (.*)$", out, re.M)
-    d["svals"] = re.search(r"^singular values of J: (.*)$", out, re.M).group(1)
+    d["svals"] = search(r"^singular values of J: (.*)$", out, path, "'singular values of J: ...'").group(1)
     return d
+
+
+def missed_targets(name, d):
+    """'case region param: error' for every fitted factor off the truth by more than its tolerance."""
+    out = []
+    for i, r in enumerate(REGIONS):
+        for param, truth, tol in (("young", YOUNG, YOUNG_TOLERANCE_PCT), ("fung_c", FUNG, FUNG_TOLERANCE_PCT)):
+            if (param, r) in d["fit"]:
+                err = 100 * (d["fit"][(param, r)][0] / truth[i] - 1)
+                if not abs(err) <= tol:
+                    out.append(f"{name} {r} {param}: {err:+.1f}% (target ±{tol}%)")
+    return out
 
 
 def table(d, truth=True):
@@ -86,8 +114,8 @@ def table(d, truth=True):
         c, cs = d["fit"][("fung_c", r)]
         if truth:
             ey, ec = 100 * (y / YOUNG[i] - 1), 100 * (c / FUNG[i] - 1)
-            rows.append(f"| {r} | x{YOUNG[i]} | x{y:.4f} | {ey:+.1f}% {'ok' if abs(ey) <= 5 else 'MISSED'} | {ys} "
-                        f"| x{FUNG[i]} | x{c:.4f} | {ec:+.1f}% {'ok' if abs(ec) <= 10 else 'MISSED'} | {cs} |")
+            rows.append(f"| {r} | x{YOUNG[i]} | x{y:.4f} | {ey:+.1f}% {'ok' if abs(ey) <= YOUNG_TOLERANCE_PCT else 'MISSED'} | {ys} "
+                        f"| x{FUNG[i]} | x{c:.4f} | {ec:+.1f}% {'ok' if abs(ec) <= FUNG_TOLERANCE_PCT else 'MISSED'} | {cs} |")
         else:
             ey, ec = 100 * (y / YOUNG[i] - 1), 100 * (c / FUNG[i] - 1)
             rows.append(f"| {r} | x{YOUNG[i]} | x{y:.4f} | {ey:+.1f}% | {ys} | x{FUNG[i]} | x{c:.4f} | {ec:+.1f}% | {cs} |")
@@ -158,7 +186,35 @@ def main():
     ap.add_argument("--work", default="/tmp/fit")
     ap.add_argument("--skip-fem", action="store_true")
     ap.add_argument("--skip-shapes", action="store_true")
+    ap.add_argument("--check", metavar="WORK", help="only judge WORK/fit_jump.log and WORK/fit_cmu.log (no runs)")
     a = ap.parse_args()
+    try:
+        if a.check:
+            sys.exit(judge_logs(a.check))
+        sys.exit(run_all(a))
+    except BadResults as e:
+        print(f"fit_benchmark: {e}", file=sys.stderr)
+        sys.exit(EXIT_BAD_INPUT)
+
+
+def judge_logs(work):
+    """The known-truth cases' tables from the fit logs in `work`; exit status 0 or EXIT_MISSED."""
+    paths = {name: os.path.join(work, f"fit_{name}.log") for name in ["jump", "cmu"]}
+    cases = {name: parse_fit(read_text(path), path) for name, path in paths.items()}  # every log read before output
+    missed = []
+    for name, d in cases.items():
+        print(f"## {name}\n\n{table(d)}\n")
+        missed += missed_targets(name, d)
+    return report_missed(missed)
+
+
+def report_missed(missed):
+    for m in missed:
+        print(f"fit_benchmark: target missed: {m}", file=sys.stderr)
+    return EXIT_MISSED if missed else 0
+
+
+def run_all(a):
     os.makedirs(a.work, exist_ok=True)
     w = lambda name: os.path.join(a.work, name)
     res = os.path.join(ROOT, "scripts", "results")
@@ -177,11 +233,11 @@ def main():
         out, wall, cpu = run(["fit", "--avatar", w("avatar.h5"), "--observed", w(f"obs_{name}.h5"), "--noise", "0.001",
                               "--params", "young,fung_c", "--out", w(f"fitted_{name}.yaml"),
                               "--plot", os.path.join(res, f"fit_{name}.svg")], w(f"fit_{name}.log"), reuse=True)
-        cases[name] = parse_fit(out)
+        cases[name] = parse_fit(out, w(f"fit_{name}.log"))
     out, _, _ = run(["fit", "--avatar", w("avatar.h5"), "--observed", w("obs_jump.h5"), "--noise", "0.001", "--numeric",
                      "--max-iterations", "1", "--out", w("fitted_numeric.yaml"), "--plot", w("numeric.svg")],
                     w("fit_numeric.log"), reuse=True)
-    numeric = parse_fit(out)
+    numeric = parse_fit(out, w("fit_numeric.log"))
     if not a.skip_fem:
         if not os.path.exists(w("obs_fem.h5")):
             run(["fit", "--avatar", w("avatar.h5"), "--material", w("truth.yaml"), "--motion", "builtin:jump",
@@ -189,7 +245,7 @@ def main():
         out, _, _ = run(["fit", "--avatar", w("avatar.h5"), "--observed", w("obs_fem.h5"), "--start-at-rest",
                          "--params", "young,fung_c", "--out", w("fitted_fem.yaml"),
                          "--plot", os.path.join(res, "fit_fem.svg")], w("fit_fem.log"), reuse=True)
-        cases["fem"] = parse_fit(out)
+        cases["fem"] = parse_fit(out, w("fit_fem.log"))
     shape_md = [] if a.skip_shapes else shapes(w, res)
     load1 = os.getloadavg()
 
@@ -216,6 +272,7 @@ def main():
     with open(os.path.join(res, "fit.md"), "w") as f:
         f.write("\n".join(md))
     print("wrote", os.path.join(res, "fit.md"))
+    return report_missed(missed_targets("jump", cases["jump"]) + missed_targets("cmu", cases["cmu"]))
 
 
 if __name__ == "__main__":

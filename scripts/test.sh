@@ -28,21 +28,18 @@ JOBS="${SFLSH_JOBS:-$(nproc)}"
 if [ "$SANITIZE" = 0 ]; then
   bash scripts/build.sh
   cd "${SFLSH_BUILD_DIR:-build}"
-  # A failed test is run once more: TemplateVolume.CacheRoundTripAndCorruptFile
-  # sometimes aborts after it passed ("corrupted size vs. prev_size" at exit,
-  # only under parallel ctest; cause not found yet, README "Reliability"). A
-  # test that fails twice still fails the suite.
-  ctest --output-on-failure -j "$JOBS" --repeat until-pass:2 "$@"
+  # Every test runs once: a failure fails the suite. No test asserts on wall
+  # time (speed is measured by the benchmarks); waits for another thread or
+  # process have generous deadlines that only guard against a hang.
+  ctest --output-on-failure -j "$JOBS" "$@"
   exit 0
 fi
 
 # Heavy under the sanitizers: meshing the body (CGAL), the precompute pipeline,
 # file-betas builds and long tracking runs (minutes at -O1 with ASan on 2
-# cores; chosen by what the tests do, not yet timed under ASan), and the timing
-# assertions, which are meaningless under ASan. Measured under ASan: test_core
-# 0.2 s, test_io 2.9 s, test_body 67 s (all pass).
+# cores; chosen by what the tests do, not yet timed under ASan). Measured under
+# ASan: test_core 0.2 s, test_io 2.9 s, test_body 67 s (all pass).
 SANITIZE_EXCLUDE='^(PipelineCli|FileBetas|TemplateVolume|ShapeVolume|PelvisTracking)\.'
-SANITIZE_EXCLUDE+='|^(Simulator\.StepTimeAtSixtyFourHandles|BodyModel\.PosingTenThousandVerticesIsFast|BvhParser\.TenThousandFramesParseTime)$'
 DIR="${SFLSH_ASAN_BUILD_DIR:-build-asan}"
 # The module libraries are unity builds here (scripts/sanitize_unity.cmake);
 # these sources define file-local names that another source of their module
@@ -63,7 +60,6 @@ cmake -S . -B "$DIR" -DCMAKE_BUILD_TYPE=Sanitize \
 # CI under 30 min; `--sanitize` runs them.
 SANITIZE_CI_TARGETS=(test_core test_io test_teleop test_mesh test_fem test_asset test_motion)
 SANITIZE_CI_FILTER='-PipelineCli.*:FileBetas.*:TemplateVolume.*:ShapeVolume.*:PelvisTracking.*'
-SANITIZE_CI_FILTER+=':Simulator.StepTimeAtSixtyFourHandles:BodyModel.PosingTenThousandVerticesIsFast:BvhParser.TenThousandFramesParseTime'
 # Tests that run the sflsh executable, which this build does not make.
 SANITIZE_CI_FILTER+=':MotionCli.*:AssimpExportCli.*'
 BUILD_ARGS=()

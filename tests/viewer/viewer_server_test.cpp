@@ -139,10 +139,9 @@ TEST(ViewerServer, SlowClientGetsTheLatestFrameNotABacklog) {
   ViewerServer server(big, o);
   test::Client a(server.port());
   a.read();  // scene
-  // 200 frames published while the client reads nothing: publish never blocks.
-  const auto t0 = std::chrono::steady_clock::now();
+  // 200 frames published while the client reads nothing: publish never blocks
+  // (a blocking publish would never return here: the client reads only after).
   for (int i = 1; i <= 200; ++i) server.publish(frame_of(server.scene(), i * 1e-3));
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   // Whatever was in flight, the client ends on frame 200 after few messages.
   QuantizedSkin state;

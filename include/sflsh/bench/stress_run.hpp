@@ -21,9 +21,28 @@ struct StressOptions {
   double dt = 1.0 / 30.0;
   long steps = 10000;
   int window = 100;  ///< steps per summary window
-  /// Peak soft displacement over the last window may be at most this times
-  /// the largest over the first 10 % of the run (no energy growth).
+  /// No energy growth: the peak soft displacement over the last window may be
+  /// at most this times a reference taken earlier in the same run: a run of at
+  /// least two full windows compares its last window with the first 10 %
+  /// (growth_reference_share) of its windows.
   double growth_limit = 1.5;
+  /// A run shorter than two windows (every CMU case: 11–60 steps) compares the
+  /// largest peak of its last tenth of the steps (at least one) with every step
+  /// before it, and may grow by this factor: a clip may end at its most violent
+  /// motion (cmu_3x 09_03 on the default avatar ends at 69.6 mm, 1.84× every
+  /// step before), while a run that blows up grows geometrically, step after
+  /// step, far past it.
+  double short_run_growth_limit = 3.0;
+  /// The share of the windows, from the start, whose largest peak is the
+  /// reference of a run of at least two full windows (0.1: the first 10 %).
+  /// The suite's scenes use 0.5: their events (a landing, the body tipping
+  /// over, a press) come in their first seconds, which in a run of a few
+  /// hundred steps is more than its first tenth.
+  double growth_reference_share = 0.1;
+  /// Rejected steps allowed (a rejected step is a step that made no progress).
+  long max_rejected = 0;
+  /// Damped Newton iterations allowed per step, on average over the run.
+  double max_damped_per_step = 1.0;
   /// The simulated pelvis may be at most this far from the motion's root
   /// after any step (mm; scripts/mocap_check.sh's 20 mm). ≤ 0: not checked.
   double pelvis_tolerance_mm = 20;
@@ -52,13 +71,29 @@ struct StressReport {
   double pelvis_error_max_mm = 0, pelvis_error_mean_mm = 0;
   long planned_steps = 0;        ///< steps the run should take (run_step_count)
   double ms_median = 0;          ///< step wall time (ms)
-  double peak_soft_mm_early = 0, peak_soft_mm_late = 0;  ///< first 10 % of windows, last window
+  /// Peak soft displacement after every step (mm; what the short-run growth check reads).
+  std::vector<double> step_peak_soft_mm;
+  /// The growth check's reference and late figures (StressOptions::growth_limit
+  /// says which steps): early = the first 10 % of windows (growth_reference_share),
+  /// or every step before the last tenth of a short run; late = last window, or
+  /// that last tenth.
+  double peak_soft_mm_early = 0, peak_soft_mm_late = 0;
+  bool short_run = false;        ///< fewer than two full windows: the growth check used steps
+  long max_rejected = 0;         ///< the limits judged against (StressOptions)
+  double max_damped_per_step = 0, pelvis_tolerance_mm = 0, growth_limit = 0;
   /// finite: no non-finite state; complete: steps == planned_steps; stable:
-  /// the last window's peak soft displacement ≤ growth_limit × the first 10 %
-  /// of windows' (trivially true with one window, e.g. a 2× CMU clip);
-  /// no_inversion: min det F > 0; tracking: pelvis_error_max_mm ≤ the tolerance.
-  bool finite = true, complete = true, stable = true, no_inversion = true, tracking = true;
-  bool passed() const { return finite && complete && stable && no_inversion && tracking; }
+  /// peak_soft_mm_late ≤ growth_limit (short_run_growth_limit for a short run)
+  /// × peak_soft_mm_early; no_inversion:
+  /// min det F > 0; tracking: pelvis_error_max_mm ≤ the tolerance;
+  /// few_rejected: rejected ≤ max_rejected; few_damped: damped ≤
+  /// max_damped_per_step × steps.
+  bool finite = true, complete = true, stable = true, no_inversion = true, tracking = true, few_rejected = true,
+       few_damped = true;
+  bool passed() const {
+    return finite && complete && stable && no_inversion && tracking && few_rejected && few_damped;
+  }
+  /// The first failed check in words ("" when passed), e.g. "3 rejected steps (at most 0)".
+  std::string failure() const;
   std::string describe() const;
 };
 
@@ -67,6 +102,12 @@ struct StressReport {
 /// shorter than steps·dt ends the run early (report.steps says how many ran);
 /// built-in motions are made long enough.
 StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOptions& options);
+
+/// The checks of a finished run: fills min_det, peak_soft_mm, the growth
+/// figures and every flag of `report` from its windows, step_peak_soft_mm,
+/// counts, steps and planned_steps (set by run_stress; tests set them by hand)
+/// and the limits of `options`.
+void judge_stress(StressReport& report, const StressOptions& options);
 
 /// CSV (one row per window) and an SVG plot of peak soft displacement, elastic
 /// energy and min det F over time.

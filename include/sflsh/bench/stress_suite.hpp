@@ -19,6 +19,16 @@
 //                  every `window` steps
 // The default list: shake@1/30, shake@1/15, torture@1/30, cmu_2x@1/30,
 // cmu_3x@1/30, fall_on_floor, box_press.
+//
+// A case passes when its state stays finite, it runs every planned step, no
+// cubature sample inverts (det F > 0), the soft displacement does not grow
+// (StressOptions::growth_limit, short_run_growth_limit in a run shorter than
+// two windows; scenes: per output frame, one per window or, in a run shorter
+// than two windows, one per step),
+// the pelvis stays within 20 mm of the motion's root (motion cases), and it
+// stays within its limits (stress_case_limits): rejected steps, damped Newton
+// iterations per step and, for the scenes, the deepest penetration of any
+// contact pair.
 #include <functional>
 #include <memory>
 #include <string>
@@ -28,6 +38,32 @@
 #include "sflsh/bench/stress_run.hpp"
 
 namespace sflsh {
+
+/// What a case may not exceed (besides the checks every case has, above).
+struct StressCaseLimits {
+  long max_rejected = 0;             ///< rejected steps
+  double max_damped_per_step = 1;    ///< damped Newton iterations per step, on average
+  double max_penetration_mm = -1;    ///< deepest penetration of any contact pair (scenes; < 0: not checked)
+};
+
+/// The limits of case `name` (without @DT), from the recorded suites
+/// (scripts/results/stress_suite*.md) with room above them:
+///   shake          0 rejected, ≤ 0.01 damped per step (recorded: 0; 1,666 in 10⁴
+///                  steps before the joint springs were sized by the flesh they move)
+///   torture        0 rejected, ≤ 2 damped per step (the targets jump by ~3 rad every
+///                  0.2 s and the rotation cap is what holds them: recorded 0.91–0.92
+///                  at 1/30 on the default body, 1.36 at 1/15 on the synthetic test
+///                  body; a step has at most 1 + iterations_after_damping = 4)
+///   cmu_2x, cmu_3x 0 rejected, ≤ 1 damped per step (recorded ≤ 0.82, 9 in 11 steps)
+///   fall_on_floor  0 rejected, ≤ 1 damped per step (the damped iterations come with
+///                  the landing, so their share depends on the run's length: 0.013–0.061
+///                  over 10⁴ steps, 0.15 over 600 on a coarse body), penetration ≤ 5 mm
+///                  (scripts/contact_figures.py's target; recorded 3.85–4.2 mm)
+///   box_press      0 rejected, ≤ 1 damped per step (recorded ≤ 0.002 over 10⁴ steps,
+///                  0.04 over 600), penetration ≤ 10 mm (the box goes 20 mm into the
+///                  belly; recorded 4.75–4.84 mm)
+/// Throws sflsh::Error for an unknown name.
+StressCaseLimits stress_case_limits(const std::string& name);
 
 /// The case names (without @DT).
 const std::vector<std::string>& stress_suite_case_names();
@@ -67,8 +103,19 @@ struct StressCaseResult {
   double peak_soft_mm = 0;
   double pelvis_max_mm = -1, pelvis_mean_mm = -1;  ///< < 0: no motion root
   double ms_median = 0;
+  double max_penetration_mm = -1;   ///< scenes: deepest penetration of any contact pair; < 0: none
+  double peak_soft_mm_early = 0, peak_soft_mm_late = 0;  ///< the growth check's figures (StressReport)
   std::vector<double> window_t, window_peak_soft_mm;  ///< per window, for the plot
 };
+
+/// The result of a case from its stress report (`has_root`: the pelvis error
+/// is against a motion root): status FAILED with report.failure() as the
+/// message unless report.passed().
+StressCaseResult stress_case_result(const std::string& name, const std::string& setup, double dt,
+                                    const StressReport& report, bool has_root);
+/// Marks `result` FAILED (unless it failed already) when its max_penetration_mm
+/// exceeds limits.max_penetration_mm (≥ 0) or is not finite.
+void check_stress_case_penetration(StressCaseResult& result, const StressCaseLimits& limits);
 
 /// Validates the options (every case spec parses, steps/window >= 1): throws
 /// one sflsh::Error naming the option and the accepted values.
