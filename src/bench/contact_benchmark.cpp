@@ -218,7 +218,7 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
     co.patch = o.patch;
     co.patch_radius = o.patch_radius;
     mb.add_term(std::make_shared<const ContactPatchTerm>(kObject, *avatar, std::make_shared<geometry::SphereSdf>(sc.radius),
-                                                         Isometry::Identity(), co),
+                                                         Isometry::Identity(), false, co),
                 {body});
   }
   Simulator sim(mb.build());

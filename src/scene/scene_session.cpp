@@ -322,13 +322,20 @@ void SceneSession::Impl::build() {
       auto& pts = samples[b.avatar.get()];
       if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
       const bool dynamic = o.model_index >= 0;
-      if (c.patch && !dynamic) {
+      if (c.patch) {
+        require(!dynamic, sc.path, ": contact.patch: object '", o.desc->name,
+                "' is dynamic; the contact patch takes static and kinematic objects (a dynamic one: "
+                "remove contact.patch or make it kinematic)");
         ContactPatchOptions po;
         po.pressure_stiffness = c.pressure_stiffness;
         po.spacing = c.patch_spacing;
         po.patch_radius = c.patch_radius;
-        mb.add_term(std::make_shared<const ContactPatchTerm>(o.desc->name, *b.avatar, o.model.field, Isometry::Identity(), po),
-                    {b.model_index});
+        auto term = std::make_shared<const ContactPatchTerm>(
+            o.desc->name, *b.avatar, o.model.field, dynamic ? o.model.shape_in_body : Isometry::Identity(), dynamic, po);
+        if (dynamic)
+          mb.add_term(term, {b.model_index, o.model_index});
+        else
+          mb.add_term(term, {b.model_index});
         continue;
       }
       SdfContactOptions co;

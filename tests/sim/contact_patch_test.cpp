@@ -82,7 +82,7 @@ TEST(ContactPatch, UniformPenetrationGivesPressureStiffnessTimesDepthTimesArea) 
     o.spacing = spacing;
     o.patch = false;
     const ContactPatchTerm term("floor", a, std::make_shared<geometry::PlaneSdf>(Vec3(0, 1, 0), 0.0),
-                                Isometry::Identity(), o);
+                                Isometry::Identity(), false, o);
     StepContext ctx = context(a, &frames, false);
     const auto cache = begin_term_step(term, ctx);
     ASSERT_TRUE(term.active(ctx));
@@ -107,7 +107,7 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
   o.spacing = 0.003;
   o.patch_radius = 0.015;
   o.inner_tolerance = 1e-13;
-  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), o);
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false, o);
   for (bool dynamic : {false, true}) {
     StepContext ctx = context(a, &frames, dynamic);
     // Some subspace displacement and a moved body, so every piece is non-trivial.
@@ -193,7 +193,7 @@ std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iter
   co.patch_radius = 1.0;  // the whole body
   co.inner_tolerance = 1e-13;
   mb.add_term(std::make_shared<const ContactPatchTerm>("ball", a, std::make_shared<geometry::SphereSdf>(0.012),
-                                                       Isometry::Identity(), co),
+                                                       Isometry::Identity(), false, co),
               {body});
   return mb.build();
 }
@@ -228,10 +228,69 @@ TEST(ContactPatch, CoveringTheWholeBodyTheStepIsTheFullSpaceStep) {
   EXPECT_GT(worst_subspace, 0.1 * peak) << "the coarse subspace alone should not make the dent";
 }
 
+TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFiniteDifferences) {
+  // The slab (bones kinematic, 6 handles) and a ball as a rigid body bound
+  // second: the term's local system is [z (18) | ball (6)].
+  const Avatar a = slab(6);
+  ContactPatchOptions o;
+  o.pressure_stiffness = 2.0e7;
+  o.spacing = 0.003;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-14;
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), true, o);
+  for (bool dynamic_bones : {false, true}) {
+  SCOPED_TRACE(dynamic_bones ? "bones dynamic" : "bones kinematic");
+  StepContext ctx = context(a, nullptr, dynamic_bones);
+  Configuration ball, ball_prev;
+  ball.bones = {Isometry::Identity()};
+  ball.bones[0].translation() = Vec3(0.004, 0.03 + 0.012 - 0.0015, -0.003);  // 1.5 mm into the top
+  ball.z = VecX();
+  ball_prev = ball;
+  DofLayout ball_layout;
+  ball_layout.num_bones = 1;
+  ball_layout.num_reduced = 0;
+  ball_layout.base = ctx.layout.size();
+  Configuration q = ctx.q_prev;
+  for (int i = 0; i < q.z.size(); ++i) q.z[i] = 4e-4 * std::sin(1.3 * i + 0.2);
+  ctx.bound = {{0, 0, &a, ctx.layout, &q, &ctx.q_prev, &ctx.q_prev2},
+               {1, 1, nullptr, ball_layout, &ball, &ball_prev, &ball_prev}};
+  const auto cache = begin_term_step(term, ctx);
+  ASSERT_FALSE(term.patch_nodes(ctx).empty());
+  const int n = ctx.layout.size() + 6;
+  VecX g = VecX::Zero(n);
+  const double E = term.evaluate(ctx, q, &g, nullptr);
+  ASSERT_GT(E, 0);
+  // Central differences over the body's z and the ball's (ω, v).
+  VecX fd(n);
+  const double eps = 1e-7;
+  for (int i = 0; i < n; ++i) {
+    double Es[2];
+    for (int sgn = 0; sgn < 2; ++sgn) {
+      VecX d = VecX::Zero(n);
+      d[i] = sgn ? -eps : eps;
+      Configuration qi = retract(q, d, ctx.layout), bi = retract(ball, d, ball_layout);
+      ctx.bound[0].q = &qi;
+      ctx.bound[1].q = &bi;
+      Es[sgn] = term.evaluate(ctx, qi, nullptr, nullptr);
+    }
+    fd[i] = (Es[0] - Es[1]) / (2 * eps);
+  }
+  ctx.bound[0].q = &q;
+  ctx.bound[1].q = &ball;
+  EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "|g| " << g.norm() << ", |fd| " << fd.norm();
+  // The ball's generalized force is the reaction of the contact force on the body: −f along v.
+  const auto r = term.report(ctx, q);
+  const Vec3 f(quantity(r, "force", 0), quantity(r, "force", 1), quantity(r, "force", 2));
+  ASSERT_LT(f.y(), -0.01);  // the ball pushes the slab's top down
+  // ∂E/∂v_ball = Σ κ a φ ∂φ/∂v = −Σ κ a φ ∇φ: the force on the body, so the ball gets −f.
+  EXPECT_LT((g.segment<3>(ctx.layout.size() + 3) - f).norm(), 1e-6 * f.norm());
+  }
+}
+
 TEST(ContactPatch, BadOptionsAreRefusedNamingTheContact) {
   const Avatar a = slab(4);
   auto sphere = std::make_shared<geometry::SphereSdf>(0.01);
-  auto make = [&](ContactPatchOptions o) { ContactPatchTerm("probe", a, sphere, Isometry::Identity(), o); };
+  auto make = [&](ContactPatchOptions o) { ContactPatchTerm("probe", a, sphere, Isometry::Identity(), false, o); };
   for (double k : {0.0, -1.0, double(NAN)}) {
     ContactPatchOptions o;
     o.pressure_stiffness = k;

@@ -258,10 +258,11 @@ struct ContactDescription {
   bool all_pairs = true;
   /// Colliding pairs by name (each has a body; object–object contact is not modelled).
   std::vector<std::pair<std::string, std::string>> pairs;
-  /// contact.patch: body–object contact with static and kinematic objects
-  /// sampled over the skin's faces with a pressure stiffness, and a full-space
-  /// patch under it (sim/energies/contact_patch.hpp). Frictionless: refused
-  /// with friction > 0. Dynamic objects and tools keep the per-sample penalty.
+  /// contact.patch: body–object contact sampled over the skin's faces with a
+  /// pressure stiffness, and a full-space patch under it
+  /// (sim/energies/contact_patch.hpp), for static and kinematic objects.
+  /// Frictionless: refused with friction > 0; a dynamic object is refused
+  /// when the scene is built. Tools keep the per-sample penalty.
   bool patch = false;
   double patch_radius = 0.04;           ///< m
   double pressure_stiffness = 1.0e8;    ///< N/m³

@@ -56,6 +56,7 @@ struct PatchCache : TermCache {
   // linearization of the last Hessian evaluation: δu(z) ≈ du_lin − Φ_pp⁻¹ Φ_pz (z − z_lin).
   bool solved = false;
   Configuration q_solved;
+  Isometry object_solved = Isometry::Identity();
   bool linearized = false;
   VecX z_lin, du_lin;
   MatX Hpz;                     // Φ_pz (patch DoFs by z)
@@ -93,8 +94,13 @@ void add_offset_rotation_gradient(const Row& w, const std::vector<Isometry>& bon
 }  // namespace
 
 ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry::SdfPtr field,
-                                   const Isometry& shape_in_frame, const ContactPatchOptions& o)
-    : object_(std::move(object)), avatar_(&a), field_(std::move(field)), shape_in_frame_(shape_in_frame), options_(o) {
+                                   const Isometry& shape_in_frame, bool dynamic_object, const ContactPatchOptions& o)
+    : object_(std::move(object)),
+      avatar_(&a),
+      field_(std::move(field)),
+      shape_in_frame_(shape_in_frame),
+      dynamic_(dynamic_object),
+      options_(o) {
   const std::string what = "contact with '" + object_ + "'";
   require(field_ != nullptr, what, ": no field");
   check_contact_sampling(o.pressure_stiffness, o.spacing, what);
@@ -161,6 +167,12 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     for (int i = 0; i < 3; ++i) vertex_faces_[a.surface_faces(f, i)].push_back(f);
 }
 
+int ContactPatchTerm::object_offset(const StepContext& ctx) const {
+  if (!dynamic_) return -1;
+  require(ctx.bound.size() == 2 && ctx.bound[1].q != nullptr, name(), ": the object's body is not bound");
+  return ctx.bound[1].layout.base;
+}
+
 std::unique_ptr<TermCache> ContactPatchTerm::make_cache() const { return std::make_unique<PatchCache>(); }
 
 std::vector<int> ContactPatchTerm::patch_nodes(const StepContext& ctx) const { return patch_cache(ctx, name()).nodes; }
@@ -180,17 +192,31 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     else
       ++it;
   }
-  require(ctx.frames != nullptr, name(), ": the step has no world frames");
-  const auto fr = ctx.frames->find(object_);
-  require(fr != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
-  const WorldFrame& f = fr->second;
-  require(f.pose.matrix().allFinite(), name(), ": world frame '", object_, "' is not finite");
-  c.field_pose = f.pose * shape_in_frame_;
-  const Isometry T_inv = c.field_pose.inverse();
   const geometry::Aabb local = field_->bounds();
   const bool bounded = !local.is_unbounded();
   const double extent = bounded ? 0.5 * (local.max - local.min).norm() : 1.0;
-  const double object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
+  double object_motion = 0;
+  if (dynamic_) {
+    // The object's pose at t (the broad phase's reference) and its motion over the last step, doubled.
+    require(ctx.bound.size() == 2 && ctx.bound[1].q_prev != nullptr, name(),
+            ": a dynamic object's contact is bound to the body and the object");
+    const Isometry& G = ctx.bound[1].q_prev->bones[0];
+    c.field_pose = G * shape_in_frame_;
+    if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
+      const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];
+      const double angle = Eigen::AngleAxisd(G.linear() * Gp.linear().transpose()).angle();
+      object_motion = 2 * ((G.translation() - Gp.translation()).norm() + angle * extent);
+    }
+  } else {
+    require(ctx.frames != nullptr, name(), ": the step has no world frames");
+    const auto fr = ctx.frames->find(object_);
+    require(fr != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
+    const WorldFrame& f = fr->second;
+    require(f.pose.matrix().allFinite(), name(), ": world frame '", object_, "' is not finite");
+    c.field_pose = f.pose * shape_in_frame_;
+    object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
+  }
+  const Isometry T_inv = c.field_pose.inverse();
   const geometry::Aabb box = bounded ? local.transformed(c.field_pose) : local;
 
   // Skin vertices near the object at time t.
@@ -326,7 +352,8 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   const PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
   const DofLayout& L = local_layout(ctx);
-  const int nq = L.size(), np = int(du.size()), z0 = L.z_offset();
+  const int ob = object_offset(ctx);  // the object's 6 DoFs in the term's system, or −1
+  const int nq = std::max(L.end(), ob + 6), np = int(du.size()), z0 = L.z_offset();
   const double inv_h2 = 1.0 / (ctx.h * ctx.h);
   out = Evaluation();
   out.gp = VecX::Zero(np);
@@ -441,8 +468,12 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   }
 
   // Contact over the candidate faces' samples.
-  const Isometry& T = c.field_pose;
+  const Isometry T = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * shape_in_frame_) : c.field_pose;
   const Isometry T_inv = T.inverse();
+  // A dynamic object: g_o = Σ_s −J_oᵀ g_s, H_oo = Σ_s J_oᵀ H_s J_o, and per vertex
+  // N_v = Σ_s −λ_v J_oᵀ H_s, J_o = [−[x_s]×, I] (the object's point at x_s moves by ω × x + v).
+  using Mat63 = Eigen::Matrix<double, 6, 3>;
+  std::vector<Mat63> Nv(ob >= 0 && q_derivatives ? c.vertices.size() : 0, Mat63::Zero());
   const double kappa = options_.pressure_stiffness;
   const size_t nv = c.vertices.size();
   std::vector<Vec3> xv(nv);
@@ -494,6 +525,13 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
         g[i] += smp.lambda[i] * k * d * nrm;
         for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
       }
+      if (Nv.empty()) continue;
+      Mat63 JoT;  // J_oᵀ
+      JoT << hat(x), Mat3::Identity();
+      const Vec3 gs = k * d * nrm;
+      out.gq.segment<6>(ob) -= JoT * gs;
+      out.Hqq.block<6, 6>(ob, ob) += JoT * H * JoT.transpose();
+      for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
     }
     if (!touching) continue;
     for (int i = 0; i < 3; ++i) {
@@ -529,6 +567,17 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     const Eigen::VectorXd gq = Jv[v].transpose() * gv[v];
     for (size_t k = 0; k < cv[v].size(); ++k) out.gq[cv[v][k]] += gq[k];
   }
+  for (size_t v = 0; v < Nv.size(); ++v) {
+    if (!touched[v]) continue;
+    // Object rows: N_v J_v against the body, N_v b A_v against the patch.
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> B = Nv[v] * Jv[v];
+    for (size_t k = 0; k < cv[v].size(); ++k) {
+      out.Hqq.block<6, 1>(ob, cv[v][k]) += B.col(long(k));
+      out.Hqq.block<1, 6>(cv[v][k], ob) += B.col(long(k)).transpose();
+    }
+    for (const auto& [pj, bj] : couple[v])
+      if (pj >= 0 && bj != 0.0) out.Hqp.block<6, 3>(ob, 3 * pj) += Nv[v] * (bj * Av[v]);
+  }
   for (const auto& [key, M] : Mvw) {
     const int v = int(key / long(nv)), w = int(key % long(nv));
     const Eigen::Matrix<double, Eigen::Dynamic, 3> JM = Jv[v].transpose() * M;
@@ -558,7 +607,8 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   if (c.du.size() == 0) return c.du;
   // The integrator evaluates the final configuration several times (trial,
   // report): the minimizer is kept.
-  if (c.solved && same_configuration(q, c.q_solved)) return c.du;
+  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+  if (c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix()) return c.du;
   VecX du = c.du;
   // Warm start from the last linearization: the back-substitution of the
   // bordered Newton system for the change of z (the bones' change is left out).
@@ -618,6 +668,7 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   c.du = du;
   c.solved = true;
   c.q_solved = q;
+  c.object_solved = object;
   return du;
 }
 

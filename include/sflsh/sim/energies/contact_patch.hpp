@@ -42,7 +42,8 @@
 // releases without a pop). The displacement at t + h is the minimizer at the
 // step's final q, fixed when the integrator asks for the report.
 //
-// Objects: static or kinematic (a named world frame of the step inputs).
+// Objects: static, kinematic (a named world frame of the step inputs) or
+// dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -82,8 +83,12 @@ class ContactPatchTerm : public EnergyTerm {
  public:
   /// `field` in the object's shape frame, placed by the world frame `object`
   /// of the step inputs times `shape_in_frame`. Throws on bad options (one line).
+  /// The object is static or kinematic (a named world frame of the step
+  /// inputs, placed by `shape_in_frame`), or, when `dynamic_object`, a rigid
+  /// body of the model bound second (its configuration's bone 0 times
+  /// `shape_in_frame`; equal and opposite forces, as sdf_contact.hpp).
   ContactPatchTerm(std::string object, const Avatar& avatar, geometry::SdfPtr field, const Isometry& shape_in_frame,
-                   const ContactPatchOptions& options = {});
+                   bool dynamic_object, const ContactPatchOptions& options = {});
   std::string name() const override { return "contact:" + object_; }
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
@@ -112,11 +117,14 @@ class ContactPatchTerm : public EnergyTerm {
                         Evaluation& out) const;
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
+  /// The dynamic object's 6 DoFs in the term's local system, or −1.
+  int object_offset(const StepContext& ctx) const;
 
   std::string object_;
   const Avatar* avatar_;
   geometry::SdfPtr field_;
   Isometry shape_in_frame_;
+  bool dynamic_ = false;
   ContactPatchOptions options_;
   PosedPoints vertices_;  // skin vertices (subspace), rows truncated
   PosedPoints nodes_;     // tet nodes (subspace)
