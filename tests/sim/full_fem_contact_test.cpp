@@ -14,6 +14,7 @@
 #include <set>
 
 #include "sflsh/geometry/primitive_sdfs.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
@@ -182,14 +183,14 @@ TEST(FullFemContact, AFreeBoxOnTheFloorIsHeldByItsWeight) {
   EXPECT_LT(c.max_penetration, 1e-3);
 }
 
-// Disabled until the reduced model's rigid contact samples the skin's faces as
-// the reference does (header comment); run with --gtest_also_run_disabled_tests.
-TEST(FullFemContact, DISABLED_ReducedWithAllHandlesAgreesWithTheReferenceUnderContact) {
+// The reduced model's face-sampled contact (contact_patch.hpp, without its
+// patch: the nodal basis already spans every node) against the reference.
+TEST(FullFemContact, ReducedWithAllHandlesAgreesWithTheReferenceUnderContact) {
   test::SyntheticAvatarOptions o;
   o.handles = 0;
   o.two_regions = false;  // lumped node masses use one tet's density: equal only for one region
   const auto a = std::make_shared<const Avatar>(with_embedded_skin(test::make_synthetic_avatar(o)));
-  const double r = 0.05, k = 2.0e4, h = 1.0 / 60.0;
+  const double r = 0.05, kappa = 2.0e8, h = 1.0 / 60.0;
   auto sphere = std::make_shared<geometry::SphereSdf>(r);
 
   ModelOptions mo;
@@ -203,17 +204,23 @@ TEST(FullFemContact, DISABLED_ReducedWithAllHandlesAgreesWithTheReferenceUnderCo
   SoftTissueOptions so;
   so.mean_dilatation = false;  // the nodal basis is full FEM only with every tet's own volume change
   add_soft_tissue_terms(mb, body, so);
-  SdfContactOptions co;
-  co.stiffness = k;
-  mb.add_term(std::make_shared<const SdfContactTerm>("ball", PosedPoints::at_surface(*a), sphere, Isometry::Identity(),
-                                                     false, co),
-              {body});
+  ContactPatchOptions co;
+  co.pressure_stiffness = kappa;
+  co.spacing = 0.01;
+  co.patch = false;
+  co.inner_tolerance = 0;
+  mb.add_term(std::make_shared<const ContactPatchTerm>("ball", *a, sphere, Isometry::Identity(), false, co), {body});
   Simulator reduced(mb.build());
   FullFemOptions fo;
   fo.h = h;
   fo.max_iterations = 100;
   FullFem full(a, fo);
-  full.add_obstacle({"ball", sphere, k * 1e4});  // per-vertex k over ~1e-4 m² of skin per vertex
+  FullFemObstacle ob;
+  ob.name = "ball";
+  ob.field = sphere;
+  ob.pressure_stiffness = kappa;
+  ob.spacing = 0.01;
+  full.add_obstacle(ob);
   std::vector<int> handle_node;
   for (int n = 0; n < a->tet.num_nodes(); ++n)
     if (a->node_role[n] == int(NodeRole::Simulated)) handle_node.push_back(n);

@@ -22,10 +22,12 @@
 // has a Simulated node; the inward normal is −z. The thigh point is the
 // front-most skin vertex of the left thigh between 40 % and 60 % of the way
 // from knee to hip, within 4 cm (in x) of the thigh's axis, whose tet has a
-// Simulated node; its inward normal is −z as well. Contact: the reduced model
-// samples skin vertices (skin_contact_samples, `stiffness` N/m each); the full
-// FEM samples the skin's faces with the default pressure stiffness
-// (FullFemObstacle, κ = 1e8 N/m³, about the same over ~1.4e-4 m² per vertex).
+// Simulated node; its inward normal is −z as well. Contact: both solvers sample
+// the skin's faces with one pressure stiffness and spacing (the reduced one
+// through sim/energies/contact_patch.hpp, with or without its patch; the full
+// FEM through FullFemObstacle). The calf point is the back-most skin vertex of
+// the left calf between 50 % and 70 % of the way from ankle to knee, within
+// 3 cm (in x) of its axis; inward normal +z.
 //
 // Per scene and handle count K, compared at every step:
 //   rel_err     = ‖u − u_ref‖ / ‖u_ref‖ over skin vertices and steps (u: soft
@@ -51,7 +53,6 @@ namespace sflsh {
 /// Scene and solver settings of the contact benchmark.
 struct ContactBenchSettings {
   bool quick = false;            ///< shorter scenes (pressed 0.25 s + 0.1 s hold; impact 0.1 s)
-  double stiffness = 2.0e4;      ///< N/m per skin vertex (SdfContactOptions' default), reduced solver
   int newton_iters = 1;          ///< reduced solver's Newton iterations per step (1: the default simulator)
   double pressed_radius = 0.08;  ///< m
   double pressed_depth = 0.03;   ///< m, final depth below the undeformed belly

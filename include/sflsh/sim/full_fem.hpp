@@ -35,7 +35,10 @@
 // skipped when φ at one of its vertices exceeds its longest current edge
 // (exact for a 1-Lipschitz φ: every sample is within that edge of each vertex).
 // A candidate face's samples (per obstacle spacing) and its Hessian slots are
-// made on first use and cached.
+// made on first use and cached. Per face, the samples' derivatives are summed
+// over the three vertices' world positions first (a 9-vector and a 9x9
+// matrix: Σ_s w_s λ_i λ_j ∇φ ∇φᵀ), then mapped to the nodes once, so a
+// sample costs O(1), not O(12²).
 #include <array>
 #include <memory>
 #include <string>
