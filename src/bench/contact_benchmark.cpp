@@ -85,42 +85,31 @@ Site belly_site(const Avatar& a) {
   return s;
 }
 
-Site thigh_site(const Avatar& a) {
+/// The front-most (front) or back-most skin vertex of a limb segment from
+/// joint `lo` to joint `hi`, between the fractions s0 and s1 of its height and
+/// within `reach` (m, in x) of its axis, whose tet has a Simulated node.
+Site limb_site(const Avatar& a, int lo, int hi, double s0, double s1, double reach, bool front, const char* what) {
   require(a.joints_rest.rows() == 24, "bench-contact: the avatar has ", a.joints_rest.rows(), " joints, expected 24");
-  const Vec3 hip = a.joints_rest.row(1).transpose(), knee = a.joints_rest.row(4).transpose();  // left hip, knee
+  const Vec3 p0 = a.joints_rest.row(lo).transpose(), p1 = a.joints_rest.row(hi).transpose();
   int best = -1;
   double best_z = 0;
   for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
     const Vec3 x = a.surface_rest.row(v).transpose();
-    const double s = (x.y() - knee.y()) / (hip.y() - knee.y());
-    if (s < 0.4 || s > 0.6 || std::abs(x.x() - (knee.x() + s * (hip.x() - knee.x()))) > 0.04 || !simulated_vertex(a, v))
+    const double s = (x.y() - p0.y()) / (p1.y() - p0.y());
+    if (s < s0 || s > s1 || std::abs(x.x() - (p0.x() + s * (p1.x() - p0.x()))) > reach || !simulated_vertex(a, v))
       continue;
-    if (best < 0 || x.z() > best_z) best = v, best_z = x.z();
+    const double z = front ? x.z() : -x.z();  // the body faces +z
+    if (best < 0 || z > best_z) best = v, best_z = z;
   }
-  require(best >= 0, "bench-contact: no simulated skin vertex on the front of the left thigh");
-  Site s;
-  s.point = a.surface_rest.row(best).transpose();
-  return s;
+  require(best >= 0, "bench-contact: no simulated skin vertex on ", what);
+  Site site;
+  site.point = a.surface_rest.row(best).transpose();
+  site.outward = front ? Vec3::UnitZ() : Vec3(-Vec3::UnitZ());
+  return site;
 }
 
-Site calf_site(const Avatar& a) {
-  require(a.joints_rest.rows() == 24, "bench-contact: the avatar has ", a.joints_rest.rows(), " joints, expected 24");
-  const Vec3 knee = a.joints_rest.row(4).transpose(), ankle = a.joints_rest.row(7).transpose();  // left knee, ankle
-  int best = -1;
-  double best_z = 0;
-  for (int v = 0; v < int(a.surface_rest.rows()); ++v) {
-    const Vec3 x = a.surface_rest.row(v).transpose();
-    const double s = (x.y() - ankle.y()) / (knee.y() - ankle.y());
-    if (s < 0.5 || s > 0.7 || std::abs(x.x() - (ankle.x() + s * (knee.x() - ankle.x()))) > 0.03 || !simulated_vertex(a, v))
-      continue;
-    if (best < 0 || x.z() < best_z) best = v, best_z = x.z();  // back-most: the body faces +z
-  }
-  require(best >= 0, "bench-contact: no simulated skin vertex on the back of the left calf");
-  Site s;
-  s.point = a.surface_rest.row(best).transpose();
-  s.outward = -Vec3::UnitZ();
-  return s;
-}
+Site thigh_site(const Avatar& a) { return limb_site(a, 4, 1, 0.4, 0.6, 0.04, true, "the front of the left thigh"); }
+Site calf_site(const Avatar& a) { return limb_site(a, 7, 4, 0.5, 0.7, 0.03, false, "the back of the left calf"); }
 
 std::vector<Scene> make_scenes(const ContactBenchSettings& o) {
   require(o.pressed_radius > 0 && o.impact_radius > 0 && o.impact_speed > 0 && o.pressed_depth > 0 &&
