@@ -47,7 +47,7 @@ bool bad_somewhere(const GeometrySet& set, const Tets& e, int t, double floor_de
 
 BoundaryCapReport remove_bad_boundary_caps(Tets& elements, const GeometrySet& set,
                                            const std::vector<char>& on_surface, double floor_deg,
-                                           std::vector<int>* kept) {
+                                           std::vector<int>* kept, const std::vector<char>* bad_elsewhere) {
   require(!set.empty(), "remove_bad_boundary_caps: no geometry");
   const int N = int(set.front().rows()), T = int(elements.rows());
   require(int(on_surface.size()) == N, "remove_bad_boundary_caps: ", on_surface.size(), " surface flags for ", N,
@@ -69,20 +69,22 @@ BoundaryCapReport remove_bad_boundary_caps(Tets& elements, const GeometrySet& se
   for (const auto& [f, c] : face_count)
     if (c == 1) add_face(f, 1);
 
-  auto is_bad = [&](int t) { return bad_somewhere(set, e, t, floor_deg); };
+  require(!bad_elsewhere || int(bad_elsewhere->size()) == T, "remove_bad_boundary_caps: ",
+          bad_elsewhere ? bad_elsewhere->size() : 0, " flags for ", T, " tets");
+  auto is_bad = [&](int t) { return (bad_elsewhere && (*bad_elsewhere)[size_t(t)]) || bad_somewhere(set, e, t, floor_deg); };
   for (bool changed = true; changed;) {
     changed = false;
     for (int t = 0; t < T; ++t) {
       if (!alive[t]) continue;
       bool all_surface = true;
       for (int i = 0; i < 4; ++i) all_surface = all_surface && on_surface[e(t, i)];
-      if (!all_surface || !is_bad(t)) continue;
+      if (!all_surface) continue;
       int boundary[4], nb = 0;
       for (int i = 0; i < 4; ++i) {
         boundary[i] = face_count[tet_face(e, t, i)] == 1;
         nb += boundary[i];
       }
-      if (nb != 2) continue;
+      if (nb != 2 || !is_bad(t)) continue;
       // The boundary faces are opposite c and d; they share edge (a, b).
       int cd[2], nc = 0;
       for (int i = 0; i < 4; ++i)
@@ -123,7 +125,7 @@ BoundaryCapReport remove_bad_boundary_caps(Tets& elements, const GeometrySet& se
 
 BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
                                            std::vector<int>* kept) {
-  return remove_bad_boundary_caps(mesh.elements, GeometrySet{mesh.nodes}, on_surface, floor_deg, kept);
+  return remove_bad_boundary_caps(mesh.elements, GeometrySet{mesh.nodes}, on_surface, floor_deg, kept, nullptr);
 }
 
 BoundaryCapReport remove_bad_boundary_ears(Tets& elements, const GeometrySet& set,

@@ -34,11 +34,14 @@ struct BoundaryCapReport {
 BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
                                            std::vector<int>* kept = nullptr);
 /// The same for the tets `elements` (#T by 4) judged at every geometry of
-/// `set`: a cap goes if it is inverted or below `floor_deg` at one of them
-/// (removing a tet makes no other worse anywhere; see replacement_accepted).
+/// `set`: a cap goes if it is inverted or below `floor_deg` at one of them,
+/// or if `bad_elsewhere` (#T flags, optional) flags it (bad at placements
+/// measured outside `set`). Removing a tet makes no other worse anywhere
+/// (see replacement_accepted).
 BoundaryCapReport remove_bad_boundary_caps(Tets& elements, const GeometrySet& set,
                                            const std::vector<char>& on_surface, double floor_deg,
-                                           std::vector<int>* kept = nullptr);
+                                           std::vector<int>* kept = nullptr,
+                                           const std::vector<char>* bad_elsewhere = nullptr);
 
 /// Removes, repeatedly until none is left, every *ear* of `mesh` below the
 /// floor: a tet three of whose faces are boundary faces around an apex node
