@@ -286,7 +286,14 @@ std::vector<BatchRecord> plan_batch(const std::vector<BatchShape>& shapes, const
         r.error = "same shape and options as row " + std::to_string(first);
       } else {
         r.status = batch_output_done(r.file, model_hash, s.betas) ? "exists" : "pending";
-        if (r.status == "exists") r.topology = avatar_file_topology(r.file);
+        if (r.status == "exists") {
+          try {
+            r.topology = avatar_file_topology(r.file);
+          } catch (const Error&) {
+            // /meta says done but the tets cannot be read: no topology to record (the folder
+            // check passes such a file over).
+          }
+        }
       }
     }
     out.push_back(std::move(r));
