@@ -409,7 +409,8 @@ TemplateVolume build_template_volume(const BodyModel& model, const TemplateOptio
   // The figures above that depend on the tets are measured again after it.
   timer.reset();
   rep.topology = design_template_topology(tv, model, o.topology);
-  if (rep.topology.rounds > 0) {
+  if (tv.tet.num_elements() != rep.topology.tets_before || tv.tet.num_nodes() != rep.topology.nodes_before ||
+      rep.topology.rounds > 0) {
     rep.mesh.quality = tet_quality_report(tv.tet, rep.mesh.quality.sliver_threshold_deg);
     rep.num_outer_nodes = int(tv.outer_nodes.size());
     rep.num_inner_nodes = int(tv.inner_nodes.size());

@@ -1,8 +1,12 @@
 #include "sflsh/volume/topology_design.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <iomanip>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
@@ -252,17 +256,43 @@ TopologyDesignReport design_template_topology(TemplateVolume& tv, const BodyMode
   std::vector<Points> placement(static_cast<size_t>(G));
   std::vector<char> redo(static_cast<size_t>(G), 1);
   for (int round = 0;; ++round) {
+    // The shapes are independent: placed on all cores (each result depends on its shape alone,
+    // so the design does not depend on the thread count).
+    std::vector<int> todo;
+    for (int g = 0; g < G; ++g)
+      if (redo[size_t(g)]) todo.push_back(g);
+    std::vector<TetQualityReport> quality(static_cast<size_t>(G));
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    auto work = [&] {
+      for (size_t i; (i = next++) < todo.size();) {
+        const int g = todo[i];
+        try {
+          ShapedNodes placed = place_shape_nodes(tv, model, shapes[size_t(g)].second, thickness, so);
+          quality[size_t(g)] = placed.report.quality;
+          placement[size_t(g)] = std::move(placed.nodes);
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::current_exception();
+        }
+      }
+    };
+    const int threads = std::max(1, std::min<int>(int(todo.size()), int(std::thread::hardware_concurrency())));
+    std::vector<std::thread> pool;
+    for (int k = 1; k < threads; ++k) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    step += long(G);
+    progress.update(step);
     int bad = 0;
-    for (int g = 0; g < G; ++g) {
-      progress.update(step++);
-      if (!redo[size_t(g)]) continue;
-      ShapedNodes placed = place_shape_nodes(tv, model, shapes[size_t(g)].second, thickness, so);
-      const TetQualityReport& q = placed.report.quality;
+    for (int g : todo) {
+      const TetQualityReport& q = quality[size_t(g)];
       if (round == 0) rep.min_dihedral_before[size_t(g)] = q.min_dihedral_deg, rep.inverted_before[size_t(g)] = q.num_inverted;
       rep.min_dihedral_after[size_t(g)] = q.min_dihedral_deg, rep.inverted_after[size_t(g)] = q.num_inverted;
       redo[size_t(g)] = q.num_inverted > 0 || q.min_dihedral_deg < o.floor_deg;
       bad += redo[size_t(g)];
-      placement[size_t(g)] = std::move(placed.nodes);
     }
     if (bad == 0 || round >= o.rounds) break;
     GeometrySet set{tv.tet.nodes};

@@ -23,12 +23,14 @@ namespace sflsh {
 inline constexpr int kTemplateVolumeFormatVersion = 3;
 
 /// The template stage's topology design (volume/topology_design.hpp): the
-/// one connectivity every shape uses is repaired at a set of design shapes.
+/// one connectivity every shape uses is repaired for the corners of the shape
+/// box (skin caps) and at a set of design shapes (every repair).
 struct TopologyDesignOptions {
   /// Design shapes: β = 0; each of the first `directions` shape directions
   /// alone at −range and +range; all of them at −range, all at +range; and
-  /// the two alternating corners (+−+−..., −+−+...). directions = 0 skips the
-  /// design (the mesher's tets are kept).
+  /// the two alternating corners (+−+−..., −+−+...). The skin caps are also
+  /// screened at all 2^directions corners. directions = 0 skips the design
+  /// (the mesher's tets are kept).
   int directions = 10;
   double range = 3.0;
   /// A tet inverted or below this (deg) at a design shape is repaired (the

@@ -5,8 +5,11 @@
 // needs beyond node moves — a skin cap that turns inside out where a shape
 // makes a ridge of the skin concave, a sliver between two skin patches, a
 // needle skin triangle, a flattened skin ear — is repaired here, once, in the
-// template stage, for a set of design shapes at the same time: the node-only
-// shape stage (place_shape_nodes) runs at every design shape, and the tets
+// template stage, for the whole shape box at once. First the skin caps that
+// any corner of [−range, range]^directions turns inside out or flattens are
+// removed (skin nodes move linearly with β, so all corners are cheap to
+// screen). Then the node-only shape stage (place_shape_nodes) runs at a set of
+// design shapes (topology_design_shapes), and the tets
 // inverted or below the floor at any of them are repaired (cap removal, 2-3/
 // 3-2 flips, boundary 2-2 flips, ear removal; mesh/boundary_caps.hpp,
 // mesh/tet_flips.hpp), each repair accepted only if no design shape and not
