@@ -23,7 +23,11 @@ Usage: /usr/bin/python3 scripts/shape_quality_sweep.py [--build build] [--random
 the full procedural sweep's record is scripts/results/shape_quality_all_corners.md:
   /usr/bin/python3 scripts/shape_quality_sweep.py --models procedural --corners all --random 100 \
       --no-directions --out scripts/results/shape_quality_all_corners.md
-Template stages come from the precompute cache (~/.cache/sflsh; built on first use).
+Template stages come from the precompute cache (~/.cache/sflsh; built on first use). The
+one-topology record scripts/results/shape_topology.md (a subset that runs in ~15 min, with the
+template stage built by the run so that its time and topology design are recorded):
+  SFLSH_CACHE_DIR=$(mktemp -d) /usr/bin/python3 scripts/shape_quality_sweep.py --models procedural \
+      --corners 32 --random 20 --out scripts/results/shape_topology.md
 """
 import argparse
 import os
