@@ -38,7 +38,9 @@ import sys
 import tempfile
 import time
 
-MANIFEST_FIELDS = ["row", "line", "name", "key", "file", "status", "seconds", "peak_rss_mib", "error"]
+MANIFEST_FIELDS = ["row", "line", "name", "key", "file", "status", "topology", "seconds", "peak_rss_mib", "error"]
+# Manifests of sflsh before the topology column (the element array hash of each output).
+MANIFEST_FIELDS_WITHOUT_TOPOLOGY = [f for f in MANIFEST_FIELDS if f != "topology"]
 OUTPUT_FIELDS = ["row", "line", "name", "key", "file", "status", "seconds", "shape_seconds", "peak_rss_mib",
                  "worker", "error"]
 # Options that select rows or outputs: the driver sets them itself.
@@ -48,7 +50,7 @@ RESERVED = {"--batch", "--out-dir", "--task-index", "--shard", "--manifest", "--
 
 def read_manifest(text):
     rows = list(csv.DictReader(io.StringIO(text)))
-    if rows and list(rows[0].keys()) != MANIFEST_FIELDS:
+    if rows and list(rows[0].keys()) not in (MANIFEST_FIELDS, MANIFEST_FIELDS_WITHOUT_TOPOLOGY):
         raise ValueError("not an sflsh batch manifest (columns %s)" % list(rows[0].keys()))
     return rows
 

@@ -1,17 +1,20 @@
 #!/usr/bin/python3
-"""Shaped-mesh quality over the shape space (slow check; issue 14).
+"""Shaped-mesh quality over the shape space, on one tet topology (slow check).
 
 Runs the shape stage's geometry (shape_volume, default thickness map) on
   * the procedural body: beta = 0, 32 corners of [-3, 3]^10 (every sign pattern of
-    the first 4 components, the others at +-3 alternating, both phases), each
-    direction alone at +-3, and 100 uniform random draws (seed 2026);
+    the first 4 components, the others at +-3 alternating, both phases), the template
+    stage's design shapes (each direction alone at +-3, all -3, all +3, the two
+    alternating corners), and 100 uniform random draws (seed 2026);
   * the MakeHuman body (if ../shared/data/makehuman exists; converted into a
     temporary folder with data_tools/makehuman_to_smpl.py): beta = 0, the same 32
-    corners, every shape direction alone at +-3, and the 12 MakeHuman targets;
-and writes scripts/results/shape_quality.md: per shape the min dihedral angle, the
-number of inverted tets, tets below 8 deg, skin caps removed, the time and, for shapes below
-the bar, whether the shaped skin itself self-intersects. Every
-shape must reach >= 8 deg with no inverted tet; the exit status is 1 otherwise.
+    corners, the design shapes, and the 12 MakeHuman targets;
+and writes scripts/results/shape_quality.md: the template's tets, nodes, topology hash
+and (when built by this run) its time and topology design; per shape the min dihedral
+angle, the number of inverted tets, tets below 8 deg, the tet count, the time, for shapes
+below the bar whether the shaped skin itself self-intersects, and whether the shape kept
+the template's tets. Every shape must reach >= 8 deg with no inverted tet on the
+template's tets; the exit status is 1 otherwise.
 
 Usage: /usr/bin/python3 scripts/shape_quality_sweep.py [--build build] [--random 100]
        [--models procedural,makehuman] [--corners 32|all] [--no-directions] [--shared ../shared]
@@ -20,7 +23,11 @@ Usage: /usr/bin/python3 scripts/shape_quality_sweep.py [--build build] [--random
 the full procedural sweep's record is scripts/results/shape_quality_all_corners.md:
   /usr/bin/python3 scripts/shape_quality_sweep.py --models procedural --corners all --random 100 \
       --no-directions --out scripts/results/shape_quality_all_corners.md
-Template stages come from the precompute cache (~/.cache/sflsh; built on first use).
+Template stages come from the precompute cache (~/.cache/sflsh; built on first use). The
+one-topology record scripts/results/shape_topology.md (a subset that runs in ~15 min, with the
+template stage built by the run so that its time and topology design are recorded):
+  SFLSH_CACHE_DIR=$(mktemp -d) /usr/bin/python3 scripts/shape_quality_sweep.py --models procedural \
+      --corners 32 --random 20 --out scripts/results/shape_topology.md
 """
 import argparse
 import os
@@ -42,11 +49,13 @@ def run_sweep(binary, model, random, betas_csv=None, corners="32", directions=Tr
     # Streamed, so a long sweep shows progress (one line per shape on stderr).
     p = subprocess.Popen([binary, "--gtest_also_run_disabled_tests", "--gtest_filter=ShapeQualitySweep.*"],
                          env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    rows, tail, total = [], [], 0
+    rows, tail, total, template = [], [], 0, None
     for line in p.stdout:
         line = line.rstrip("\n")
         tail = (tail + [line])[-60:]
-        if line.startswith("SWEEP-TOTAL|"):
+        if line.startswith("SWEEP-TEMPLATE|"):
+            template = line.split("|")[1:]
+        elif line.startswith("SWEEP-TOTAL|"):
             total = int(line.split("|")[1])
         elif line.startswith("SWEEP|"):
             rows.append(line.split("|")[1:])
@@ -58,11 +67,12 @@ def run_sweep(binary, model, random, betas_csv=None, corners="32", directions=Tr
     p.wait()
     if not rows:
         sys.exit("shape_quality_sweep: no result lines from %s for %s:\n%s" % (binary, model, "\n".join(tail)))
-    return rows, time.time() - t0
+    return rows, time.time() - t0, template
 
 
 def ok(row):
-    return row[1] != "failed" and float(row[1]) >= 8.0 and row[2] == "0"
+    """>= 8 deg, none inverted, and the template's tets (column 8 of a shape that did not fail)."""
+    return row[1] != "failed" and float(row[1]) >= 8.0 and row[2] == "0" and len(row) > 7 and row[7] == "yes"
 
 
 def main():
@@ -84,8 +94,8 @@ def main():
     sections = []
     for model in a.models.split(","):
         if model == "procedural":
-            rows, wall = run_sweep(binary, "procedural", a.random, None, a.corners, not a.no_directions)
-            sections.append(("procedural body (%d shapes: %s)" % (len(rows), what(a, a.random)), rows, wall))
+            rows, wall, tmpl = run_sweep(binary, "procedural", a.random, None, a.corners, not a.no_directions)
+            sections.append(("procedural body (%d shapes: %s)" % (len(rows), what(a, a.random)), rows, wall, tmpl))
         elif model == "makehuman":
             mh = os.path.join(a.shared, "data", "makehuman")
             if not os.path.isdir(mh):
@@ -95,11 +105,11 @@ def main():
                 h5, csv = os.path.join(tmp, "mh.h5"), os.path.join(tmp, "mh_targets.csv")
                 subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "data_tools", "makehuman_to_smpl.py"), mh, h5,
                                 "--target-betas", csv], check=True, stdout=subprocess.DEVNULL)
-                rows, wall = run_sweep(binary, h5, 0, csv, a.corners, not a.no_directions)
-            sections.append(("MakeHuman body (%d shapes: %s, 12 targets)" % (len(rows), what(a, 0)), rows, wall))
+                rows, wall, tmpl = run_sweep(binary, h5, 0, csv, a.corners, not a.no_directions)
+            sections.append(("MakeHuman body (%d shapes: %s, 12 targets)" % (len(rows), what(a, 0)), rows, wall, tmpl))
         else:
             sys.exit("shape_quality_sweep: --models: unknown model '%s' (expected procedural, makehuman)" % model)
-        all_ok = write(a.out, sections)  # after every body, so a long run leaves what it measured
+        all_ok = write(a.out, sections, " ".join(["/usr/bin/python3", "scripts/shape_quality_sweep.py"] + sys.argv[1:]))
     print("shape_quality_sweep: wrote %s (%s)" % (a.out, "all shapes meet the bar" if all_ok else "SOME SHAPES FAIL"))
     return 0 if all_ok else 1
 
@@ -109,30 +119,41 @@ def what(a, random):
     if a.corners != "0":
         parts.append("%s corners" % ("all 1024" if a.corners == "all" else "32"))
     if not a.no_directions:
-        parts.append("20 single directions")
+        parts.append("24 design shapes (20 single directions, all -3, all +3, 2 alternating)")
     if random:
         parts.append("%d random" % random)
     return ", ".join(parts)
 
 
-def write(path, sections):
+def write(path, sections, command=None):
     all_ok = True
-    out = ["# Shaped-mesh quality over the shape space", "",
-           "Written by `scripts/shape_quality_sweep.py` (%s). Bar: every shape min dihedral >= 8 deg, 0 inverted."
+    out = ["# Shaped-mesh quality over the shape space, one tet topology", "",
+           "Written by `scripts/shape_quality_sweep.py` (%s). Bar: every shape min dihedral >= 8 deg, 0 inverted, "
+           "on the template's tets (the shape stage only moves nodes)."
            % time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
            "Time = shape_volume (geometry of the shape stage) per shape, wall, on a shared 2-core machine.", ""]
-    for title, rows, wall in sections:
+    if command:
+        out += ["Command:", "", "    " + command, ""]
+    for title, rows, wall, tmpl in sections:
         good = sum(ok(r) for r in rows)
         worst = min((float(r[1]) for r in rows if r[1] != "failed"), default=float("nan"))
         times = [float(r[5]) for r in rows]
-        out += ["## " + title, "",
-                "%d of %d meet the bar; worst min dihedral %.3f deg; time per shape median %.1f s, max %.1f s; "
-                "sweep wall %.0f s." % (good, len(rows), worst, sorted(times)[len(times) // 2], max(times), wall), "",
-                "| shape | min dihedral (deg) | inverted | tets < 8 deg | skin caps removed | time (s) "
-                "| skin self-intersects | ok |",
-                "|---|---|---|---|---|---|---|---|"]
-        out += ["| %s | %s | %s | %s | %s | %s | %s | %s |"
-                % (r[0], r[1], r[2], r[3], r[4], r[5], r[6] if len(r) > 6 else "-", "yes" if ok(r) else "**no**")
+        same = sum(1 for r in rows if r[1] != "failed" and len(r) > 7 and r[7] == "yes")
+        out += ["## " + title, ""]
+        if tmpl:
+            out += ["Template: %s tets, %s nodes, topology hash `%s`; %s" % (
+                tmpl[0], tmpl[1], tmpl[2], "template stage %s s: %s" % (tmpl[3], tmpl[4])
+                if float(tmpl[3]) > 0 else "template stage loaded from the cache (its figures are those of the "
+                "run that built it)"), ""]
+        out += ["%d of %d meet the bar; %d of %d kept the template's tets; worst min dihedral %.3f deg; time per "
+                "shape median %.1f s, max %.1f s; sweep wall %.0f s."
+                % (good, len(rows), same, len(rows), worst, sorted(times)[len(times) // 2], max(times), wall), "",
+                "| shape | min dihedral (deg) | inverted | tets < 8 deg | tets | time (s) "
+                "| skin self-intersects | template's tets | ok |",
+                "|---|---|---|---|---|---|---|---|---|"]
+        out += ["| %s | %s | %s | %s | %s | %s | %s | %s | %s |"
+                % (r[0], r[1], r[2], r[3], r[4], r[5], r[6] if len(r) > 6 else "-",
+                   r[7] if r[1] != "failed" and len(r) > 7 else "-", "yes" if ok(r) else "**no**")
                 for r in rows]
         invalid = [r for r in rows if not ok(r) and len(r) > 6 and r[6] == "yes"]
         if invalid:

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -14,6 +15,7 @@
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 #include "sflsh/precompute/batch_precompute.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/body/body_model_io.hpp"
@@ -148,6 +150,7 @@ void run_in_workers(const PrecomputeArgs& a, const PrecomputeOptions& o, int job
     }
     if (have && (e.exit_code == 0) == (reported.status != "failed")) {
       r.status = reported.status;
+      r.topology = reported.topology;
       r.error = reported.error;
     } else {
       r.status = "failed";
@@ -187,6 +190,8 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   const std::string manifest = a.manifest.empty() ? default_manifest(a, shard) : a.manifest;
 
   Timer wall;
+  // A manifest left by an earlier run must still describe its files (one line naming the row otherwise).
+  if (std::error_code ec; std::filesystem::exists(manifest, ec)) verify_batch_manifest(manifest);
   std::vector<BatchRecord> records = plan_batch(shapes, model, o, a.out_dir, shard, a.task_index);
   int pending = 0;
   for (const BatchRecord& r : records) pending += r.status == "pending";
@@ -212,6 +217,26 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   log_info("batch: " + std::to_string(records.size()) + " rows in this run, " + std::to_string(pending) +
            " to build" + (pending > 1 ? " with " + std::to_string(jobs) + (jobs > 1 ? " worker processes" : " process") : "") +
            ", " + std::to_string(int(records.size()) - pending) + " done already, duplicate or invalid");
+  // One tet topology per folder (seed §4): the files already there must agree with each other and
+  // with what this run builds (its template stage, built or loaded once, before any worker starts:
+  // they all load it).
+  std::optional<TemplateVolume> tv;
+  std::string topology;
+  PrecomputeReport template_report;
+  if (pending > 0 && !a.dry_run) {
+    require(jobs == 1 || !o.cache_dir.empty(),
+            "--no-cache with --jobs ", jobs, ": the worker processes share the template stage through the cache; "
+            "give a --cache-dir instead (or --jobs 1)");
+    tv = cached_template_volume(model, o, &template_report);
+    topology = tet_topology_hash(tv->tet.elements);
+    if (!template_report.template_from_cache && a.task_index >= 0)
+      log_info("batch: note: the template stage was not in the cache and was built by this task; with parallel "
+               "tasks run `sflsh precompute --template-only` with the same options first, so they share one build");
+  }
+  check_batch_topology(a.out_dir, topology,
+                       "template stage " + (template_report.template_cache_path.empty()
+                                                ? "of " + a.model + " (not cached)"
+                                                : template_report.template_cache_path));
   write_batch_manifest(records, manifest);
   if (a.dry_run) {
     std::cout << batch_summary(records, wall.seconds()) << "manifest (plan only, nothing built): " << manifest << "\n";
@@ -224,15 +249,6 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
   if (jobs > 1 && o.bbw.threads == 0) o.bbw.threads = std::max(1, cores / jobs);
 
   if (pending > 0) {
-    require(jobs == 1 || !o.cache_dir.empty(),
-            "--no-cache with --jobs ", jobs, ": the worker processes share the template stage through the cache; "
-            "give a --cache-dir instead (or --jobs 1)");
-    // The template stage once, before any worker starts: they all load it.
-    PrecomputeReport report;
-    const TemplateVolume tv = cached_template_volume(model, o, &report);
-    if (!report.template_from_cache && a.task_index >= 0)
-      log_info("batch: note: the template stage was not in the cache and was built by this task; with parallel "
-               "tasks run `sflsh precompute --template-only` with the same options first, so they share one build");
     int done = 0, failed = 0;
     Timer timer;
     auto on_done = [&](const BatchRecord& r) {
@@ -247,7 +263,7 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
     if (jobs == 1) {
       for (BatchRecord& r : records)
         if (r.status == "pending") {
-          r = precompute_batch_row(r, shapes[r.row], tv, model, o);
+          r = precompute_batch_row(r, shapes[r.row], *tv, model, o);
           on_done(r);
         }
     } else {
@@ -255,6 +271,10 @@ void run_batch(const PrecomputeArgs& a, PrecomputeOptions o) {
     }
   }
   write_batch_manifest(records, manifest);
+  for (const BatchRecord& r : records)  // every output of this run has the template's tets
+    if (!topology.empty() && r.status == "built" && r.topology != topology)
+      fail("batch: ", r.file, " (row ", r.row, ") has tet topology ", r.topology, " but the template stage has ",
+           topology, " (manifest ", manifest, ")");
   int failed = 0;
   for (const BatchRecord& r : records) failed += r.status == "failed";
   std::cout << batch_summary(records, wall.seconds()) << "manifest: " << manifest << "\n";

@@ -5,6 +5,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/io/crash_isolation.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 
 namespace sflsh {
 namespace {
@@ -52,6 +53,7 @@ void write_avatar(const Avatar& a, const std::string& path) {
   f.write_string("/meta/model_hash", a.model_hash);
   f.write_string("/meta/model_source", a.model_source);
   f.write_string("/meta/tool_version", kToolVersion);
+  f.write_string("/meta/topology_hash", tet_topology_hash(a.tet.elements));
 
   f.write_matrix("/skeleton/joints_rest", a.joints_rest);
   f.write_nd("/skeleton/parents", a.parents.data(), {std::int64_t(a.parents.size())});
@@ -146,6 +148,13 @@ static Avatar read_avatar_in_this_process(const std::string& path) {
   a.node_role = read_vec_i(f, "/tet/node_role", N);
   a.tet_region = read_vec_i(f, "/tet/region", T);
   a.tet_frames = f.read_matrix("/tet/frames", T, 9);
+  // Files written before /meta/topology_hash existed have none; where it is, it must be the tets'.
+  if (f.has("/meta/topology_hash")) {
+    const std::string stored = f.read_string("/meta/topology_hash"), actual = tet_topology_hash(a.tet.elements);
+    if (stored != actual)
+      fail(path, ": dataset /meta/topology_hash is ", stored, " but /tet/elements hashes to ", actual,
+           " (the file was altered; re-run `sflsh precompute`)");
+  }
 
   auto names = f.read_strings("/material/names");
   MatXr params = f.read_matrix("/material/parameters", std::int64_t(names.size()), 6);

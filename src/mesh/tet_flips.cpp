@@ -5,13 +5,14 @@
 #include <map>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/mesh/geometry_set.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
 namespace {
 
 using Face = std::array<int, 3>;
-using Tet = std::array<int, 4>;
+using Tet = TetNodes;
 
 Face key(int a, int b, int c) {
   Face f{a, b, c};
@@ -24,47 +25,38 @@ TetQuality quality(const Points& x, const Tet& t) {
                      x.row(t[3]).transpose());
 }
 
-// Orients the candidate tets alike (all positive if the flip is valid);
-// returns their smallest dihedral angle, or -1 if any is degenerate or they
-// disagree in orientation.
-double orient_and_rate(const Points& x, std::vector<Tet>& tets) {
-  double worst = 180;
+// Orients the candidate tets alike at the reference geometry (all positive if
+// the flip is valid there); false if one is degenerate or they disagree.
+bool orient_alike_at_reference(const GeometrySet& set, std::vector<Tet>& tets) {
   int sign = 0;
   for (Tet& t : tets) {
-    const double v = quality(x, t).signed_volume;
+    const double v = quality(set.front(), t).signed_volume;
     const int s = v > 0 ? 1 : (v < 0 ? -1 : 0);
-    if (s == 0 || (sign != 0 && s != sign)) return -1;
+    if (s == 0 || (sign != 0 && s != sign)) return false;
     sign = s;
   }
-  for (Tet& t : tets) {
+  for (Tet& t : tets)
     if (sign < 0) std::swap(t[2], t[3]);
-    worst = std::min(worst, quality(x, t).min_dihedral_deg);
-  }
-  return worst;
-}
-
-// Orients each candidate tet positively on its own (for new tets on opposite
-// sides of a shared face); returns their smallest dihedral angle, or -1 if any
-// is degenerate.
-double orient_each_and_rate(const Points& x, std::vector<Tet>& tets) {
-  double worst = 180;
-  bool degenerate = false;
-  for (Tet& t : tets) {
-    const double v = quality(x, t).signed_volume;
-    degenerate = degenerate || v == 0;
-    if (v < 0) std::swap(t[2], t[3]);
-    worst = std::min(worst, quality(x, t).min_dihedral_deg);
-  }
-  return degenerate ? -1 : worst;
+  return true;
 }
 
 // The new tets fill exactly the old ones (the flip is geometric, not just
-// combinatorial): equal total volume, relative to the old one.
-bool same_volume(const Points& x, const std::vector<Tet>& fresh, const std::vector<Tet>& old) {
-  double a = 0, b = 0;
-  for (const Tet& t : fresh) a += std::abs(quality(x, t).signed_volume);
-  for (const Tet& t : old) b += quality(x, t).signed_volume;
-  return b > 0 && std::abs(a - b) <= 1e-9 * b;
+// combinatorial): equal total volume, relative to the old one, at every
+// geometry where the old tets are all positive (where one is not, the fresh
+// ones' positivity is what replacement_accepted asks).
+bool same_volume(const GeometrySet& set, const std::vector<Tet>& fresh, const std::vector<Tet>& old) {
+  for (const Points& x : set) {
+    double a = 0, b = 0;
+    bool old_valid = true;
+    for (const Tet& t : fresh) a += std::abs(quality(x, t).signed_volume);
+    for (const Tet& t : old) {
+      const double v = quality(x, t).signed_volume;
+      old_valid = old_valid && v > 0;
+      b += v;
+    }
+    if (old_valid && !(std::abs(a - b) <= 1e-9 * b)) return false;
+  }
+  return true;
 }
 
 // The tets being flipped, with the face and edge adjacency kept up to date;
@@ -78,9 +70,10 @@ struct FlipMesh {
 
   static std::pair<int, int> edge(int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); }
 
-  explicit FlipMesh(const TetMesh& mesh) : tets(mesh.num_elements()), origin(mesh.num_elements()), alive(tets.size(), 1) {
-    for (int t = 0; t < mesh.num_elements(); ++t) {
-      for (int i = 0; i < 4; ++i) tets[t][i] = mesh.elements(t, i);
+  explicit FlipMesh(const Tets& elements)
+      : tets(elements.rows()), origin(elements.rows()), alive(tets.size(), 1) {
+    for (int t = 0; t < int(elements.rows()); ++t) {
+      for (int i = 0; i < 4; ++i) tets[t][i] = elements(t, i);
       origin[t] = t;
     }
     for (size_t t = 0; t < tets.size(); ++t) link(int(t), true);
@@ -105,51 +98,60 @@ struct FlipMesh {
       link(int(tets.size()) - 1, true);
     }
   }
-  /// Writes the live tets back to `mesh` (and their origins to `parent`).
-  void finish(TetMesh& mesh, std::vector<int>* parent) const {
+  /// Writes the live tets back to `elements` (and their origins to `parent`).
+  void finish(Tets& elements, std::vector<int>* parent) const {
     std::vector<int> keep;
     for (size_t t = 0; t < tets.size(); ++t)
       if (alive[t]) keep.push_back(int(t));
-    mesh.elements.resize(keep.size(), 4);
+    elements.resize(Eigen::Index(keep.size()), 4);
     if (parent) parent->resize(keep.size());
     for (size_t i = 0; i < keep.size(); ++i) {
-      for (int k = 0; k < 4; ++k) mesh.elements(i, k) = tets[keep[i]][k];
+      for (int k = 0; k < 4; ++k) elements(Eigen::Index(i), k) = tets[keep[i]][k];
       if (parent) (*parent)[i] = origin[keep[i]];
     }
   }
 };
 
+/// Smallest dihedral angle (deg) of tet t over the geometries, −1 if inverted at one.
+double worst_over_set(const GeometrySet& set, const Tet& t) {
+  double worst = 180;
+  for (const Points& x : set) worst = std::min(worst, worst_dihedral_deg(x, {t}));
+  return worst;
+}
+
 /// The frame of both flip passes: up to `rounds` sweeps over the tets alive
-/// when each sweep starts; every live one rated below `target_deg` is offered
-/// to `try_flip(t)` (true when it flipped t away), until a sweep flips
-/// nothing. Then the live tets are written back to `mesh`.
+/// when each sweep starts; every live one rated below `target_deg` (or
+/// inverted) at some geometry of `set` is offered to `try_flip(t)` (true when
+/// it flipped t away), until a sweep flips nothing. Then the live tets are
+/// written back to `elements`.
 template <class TryFlip>
-void sweep_bad_tets(TetMesh& mesh, FlipMesh& m, double target_deg, int rounds, std::vector<int>* parent,
-                    TryFlip try_flip) {
+void sweep_bad_tets(Tets& elements, const GeometrySet& set, FlipMesh& m, double target_deg, int rounds,
+                    std::vector<int>* parent, TryFlip try_flip) {
   for (int round = 0; round < rounds; ++round) {
     int made = 0;
     const size_t count = m.tets.size();
     for (size_t t = 0; t < count; ++t)
-      if (m.alive[t] && !(quality(mesh.nodes, m.tets[t]).min_dihedral_deg >= target_deg)) made += try_flip(t);
+      if (m.alive[t] && worst_over_set(set, m.tets[t]) < target_deg) made += try_flip(t);
     if (made == 0) break;
   }
-  m.finish(mesh, parent);
+  m.finish(elements, parent);
 }
 
 }  // namespace
 
-TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
+TetFlipReport flip_bad_tets(Tets& elements, const GeometrySet& set, double target_deg, int rounds,
+                            std::vector<int>* parent) {
+  require(!set.empty(), "flip_bad_tets: no geometry");
   TetFlipReport rep;
-  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
-  FlipMesh m(mesh);
+  rep.min_dihedral_before = tet_quality_report(TetMesh{set.front(), elements}).min_dihedral_deg;
+  FlipMesh m(elements);
   std::vector<Tet>& tets = m.tets;
   auto& face_tets = m.face_tets;
   auto& edge_tets = m.edge_tets;
   const auto edge = FlipMesh::edge;
-  const Points& x = mesh.nodes;
-  auto rate = [&](int t) { return quality(x, tets[t]).min_dihedral_deg; };
+  const Points& x = set.front();
 
-  sweep_bad_tets(mesh, m, target_deg, rounds, parent, [&](size_t t) {
+  sweep_bad_tets(elements, set, m, target_deg, rounds, parent, [&](size_t t) {
       bool done = false;
       // 2-3 across each interior face.
       for (int i = 0; i < 4 && !done; ++i) {
@@ -164,8 +166,9 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
           if (std::find(f.begin(), f.end(), tets[u][k]) == f.end()) e = tets[u][k];
         if (!edge_tets[edge(a, e)].empty()) continue;  // the new edge exists already
         std::vector<Tet> fresh = {{f[0], f[1], a, e}, {f[1], f[2], a, e}, {f[2], f[0], a, e}};
-        const double before = std::min(rate(int(t)), rate(u));
-        if (orient_and_rate(x, fresh) > before + 1e-9 && same_volume(x, fresh, {tets[t], tets[u]})) {
+        const std::vector<Tet> old = {tets[t], tets[u]};
+        if (orient_alike_at_reference(set, fresh) && same_volume(set, fresh, old) &&
+            replacement_accepted(set, fresh, old, target_deg)) {
           m.replace({int(t), u}, fresh);
           ++rep.flips_2_3;
           done = true;
@@ -188,16 +191,15 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
           for (int c : others) closed = closed && face_tets[key(a, b, c)].size() == 2;
           if (!closed || !face_tets[key(others[0], others[1], others[2])].empty()) continue;
           std::vector<Tet> fresh = {{others[0], others[1], others[2], a}, {others[0], others[1], others[2], b}};
-          // The two must lie on opposite sides of the new face: orient each on its own.
-          const double worst = orient_each_and_rate(x, fresh);
-          const double before = std::min({rate(ring[0]), rate(ring[1]), rate(ring[2])});
-          // Opposite sides: a and b on different sides of the face (others).
+          // The two lie on opposite sides of the new face: each oriented on its own at the
+          // reference, and a, b on different sides of the face (others) there.
           const Vec3 p0 = x.row(others[0]).transpose(), p1 = x.row(others[1]).transpose(),
                      p2 = x.row(others[2]).transpose();
           const Vec3 nrm = (p1 - p0).cross(p2 - p0);
           const double sa = nrm.dot(x.row(a).transpose() - p0), sb = nrm.dot(x.row(b).transpose() - p0);
-          if (sa * sb < 0 && worst > before + 1e-9 &&
-              same_volume(x, fresh, {tets[ring[0]], tets[ring[1]], tets[ring[2]]})) {
+          const std::vector<Tet> old = {tets[ring[0]], tets[ring[1]], tets[ring[2]]};
+          if (sa * sb < 0 && orient_at_reference(set, fresh) && same_volume(set, fresh, old) &&
+              replacement_accepted(set, fresh, old, target_deg)) {
             m.replace(ring, fresh);
             ++rep.flips_3_2;
             done = true;
@@ -205,21 +207,23 @@ TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::v
         }
       return done;
   });
-  rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
+  rep.min_dihedral_after = tet_quality_report(TetMesh{set.front(), elements}).min_dihedral_deg;
   return rep;
 }
 
-TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on_surface, double target_deg,
-                                      int rounds, std::vector<int>* parent) {
-  require(int(on_surface.size()) == mesh.num_nodes(), "flip_bad_boundary_edges: ", on_surface.size(),
-          " surface flags for ", mesh.num_nodes(), " nodes");
+TetFlipReport flip_bad_tets(TetMesh& mesh, double target_deg, int rounds, std::vector<int>* parent) {
+  return flip_bad_tets(mesh.elements, GeometrySet{mesh.nodes}, target_deg, rounds, parent);
+}
+
+TetFlipReport flip_bad_boundary_edges(Tets& elements, const GeometrySet& set, const std::vector<char>& on_surface,
+                                      double target_deg, int rounds, std::vector<int>* parent) {
+  require(!set.empty(), "flip_bad_boundary_edges: no geometry");
+  require(int(on_surface.size()) == set.front().rows(), "flip_bad_boundary_edges: ", on_surface.size(),
+          " surface flags for ", set.front().rows(), " nodes");
   TetFlipReport rep;
-  rep.min_dihedral_before = tet_quality_report(mesh).min_dihedral_deg;
-  FlipMesh m(mesh);
-  const Points& x = mesh.nodes;
-  auto rate = [&](int t) { return quality(x, m.tets[t]).min_dihedral_deg; };
-  auto point = [&](int n) -> Vec3 { return x.row(n).transpose(); };
-  sweep_bad_tets(mesh, m, target_deg, rounds, parent, [&](size_t t) {
+  rep.min_dihedral_before = tet_quality_report(TetMesh{set.front(), elements}).min_dihedral_deg;
+  FlipMesh m(elements);
+  sweep_bad_tets(elements, set, m, target_deg, rounds, parent, [&](size_t t) {
       bool done = false;
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j) {
@@ -245,19 +249,30 @@ TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on
           if (m.face_tets[key(node_a, q, r)].size() != 1 || m.face_tets[key(node_b, q, r)].size() != 1 ||
               m.face_tets[key(inner, q, r)].size() != 2 || !m.edge_tets[FlipMesh::edge(node_a, node_b)].empty())
             continue;
-          const Vec3 pa = point(node_a), n = (point(node_b) - pa).cross(point(inner) - pa);
-          if (n.dot(point(q) - pa) * n.dot(point(r) - pa) >= 0) continue;  // q, r on one side: not a flip
+          // q and r on opposite sides of the plane (a, b, i) at every geometry (else the two
+          // new tets would overlap there): with the orientation fixed at the reference, both
+          // new tets positive at a geometry says exactly that.
+          const Points& x = set.front();
+          const Vec3 pa = x.row(node_a).transpose(),
+                     n = (Vec3(x.row(node_b).transpose()) - pa).cross(Vec3(x.row(inner).transpose()) - pa);
+          if (n.dot(Vec3(x.row(q).transpose()) - pa) * n.dot(Vec3(x.row(r).transpose()) - pa) >= 0) continue;
           std::vector<Tet> fresh = {{node_a, node_b, q, inner}, {node_a, node_b, r, inner}};
-          // Each oriented on its own: they lie on opposite sides of (a, b, i).
-          if (orient_each_and_rate(x, fresh) <= std::min(rate(fan[0]), rate(fan[1])) + 1e-9) continue;
+          if (!orient_at_reference(set, fresh) ||
+              !replacement_accepted(set, fresh, {m.tets[fan[0]], m.tets[fan[1]]}, target_deg))
+            continue;
           m.replace(fan, fresh);
           ++rep.flips_2_2;
           done = true;
         }
       return done;
   });
-  rep.min_dihedral_after = tet_quality_report(mesh).min_dihedral_deg;
+  rep.min_dihedral_after = tet_quality_report(TetMesh{set.front(), elements}).min_dihedral_deg;
   return rep;
+}
+
+TetFlipReport flip_bad_boundary_edges(TetMesh& mesh, const std::vector<char>& on_surface, double target_deg,
+                                      int rounds, std::vector<int>* parent) {
+  return flip_bad_boundary_edges(mesh.elements, GeometrySet{mesh.nodes}, on_surface, target_deg, rounds, parent);
 }
 
 }  // namespace sflsh

@@ -21,12 +21,15 @@
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 
 namespace sflsh {
 namespace fs = std::filesystem;
 namespace {
 
-const char* kManifestHeader = "row,line,name,key,file,status,seconds,peak_rss_mib,error";
+const char* kManifestHeader = "row,line,name,key,file,status,topology,seconds,peak_rss_mib,error";
+// Manifests written before the topology column; still read (topology "").
+const char* kManifestHeaderWithoutTopology = "row,line,name,key,file,status,seconds,peak_rss_mib,error";
 
 std::string trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
@@ -283,6 +286,14 @@ std::vector<BatchRecord> plan_batch(const std::vector<BatchShape>& shapes, const
         r.error = "same shape and options as row " + std::to_string(first);
       } else {
         r.status = batch_output_done(r.file, model_hash, s.betas) ? "exists" : "pending";
+        if (r.status == "exists") {
+          try {
+            r.topology = avatar_file_topology(r.file);
+          } catch (const Error&) {
+            // /meta says done but the tets cannot be read: no topology to record (the folder
+            // check passes such a file over).
+          }
+        }
       }
     }
     out.push_back(std::move(r));
@@ -301,6 +312,7 @@ BatchRecord precompute_batch_row(const BatchRecord& pending, const BatchShape& s
     require(shape.error.empty(), "row ", shape.row, " is not valid: ", shape.error);
     const Avatar a = precompute_shape(tv, model, shape.betas, options);
     write_avatar(a, mine);  // itself atomic (mine.partial -> mine)
+    r.topology = tet_topology_hash(a.tet.elements);
     std::error_code ec;
     fs::rename(mine, r.file, ec);
     if (ec) fail("cannot move ", mine, " to ", r.file, ": ", ec.message());
@@ -325,7 +337,7 @@ void write_batch_manifest(const std::vector<BatchRecord>& records, const std::st
     f << kManifestHeader << '\n';
     for (const BatchRecord& r : records)
       f << r.row << ',' << r.line << ',' << csv_field(r.name) << ',' << r.key << ',' << csv_field(r.file) << ','
-        << r.status << ',' << fixed(r.seconds, 3) << ',' << fixed(r.peak_rss_mib, 1) << ',' << csv_field(r.error)
+        << r.status << ',' << r.topology << ',' << fixed(r.seconds, 3) << ',' << fixed(r.peak_rss_mib, 1) << ',' << csv_field(r.error)
         << '\n';
     if (!f) fail(path, ": write failed");
   }
@@ -336,19 +348,24 @@ std::vector<BatchRecord> read_batch_manifest(const std::string& path) {
   std::ifstream in(path);
   if (!in) fail(path, ": cannot open the manifest");
   std::string line;
-  if (!std::getline(in, line) || line != kManifestHeader)
+  if (!std::getline(in, line)) line.clear();
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  const bool with_topology = line == kManifestHeader;
+  if (!with_topology && line != kManifestHeaderWithoutTopology)
     fail(path, ":1: not a batch manifest (expected the header '", kManifestHeader, "')");
+  const size_t fields = with_topology ? 10 : 9, t = with_topology ? 1 : 0;  // t: shift after the topology column
   std::vector<BatchRecord> out;
   int lineno = 1;
   while (std::getline(in, line)) {
     ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     const auto f = split_csv(line);
-    if (f.size() != 9) fail(path, ":", lineno, ": expected 9 fields, found ", f.size());
+    if (f.size() != fields) fail(path, ":", lineno, ": expected ", fields, " fields, found ", f.size());
     BatchRecord r;
     double row = 0, ln = 0;
-    if (!parse_number(f[0], &row) || !parse_number(f[1], &ln) || !parse_number(f[6], &r.seconds) ||
-        !parse_number(f[7], &r.peak_rss_mib))
+    if (!parse_number(f[0], &row) || !parse_number(f[1], &ln) || !parse_number(f[6 + t], &r.seconds) ||
+        !parse_number(f[7 + t], &r.peak_rss_mib))
       fail(path, ":", lineno, ": row, line, seconds and peak_rss_mib must be numbers");
     r.row = int(row);
     r.line = int(ln);
@@ -356,10 +373,63 @@ std::vector<BatchRecord> read_batch_manifest(const std::string& path) {
     r.key = f[3];
     r.file = f[4];
     r.status = f[5];
-    r.error = f[8];
+    if (with_topology) r.topology = f[6];
+    r.error = f[8 + t];
+    r.manifest_line = lineno;
     out.push_back(std::move(r));
   }
   return out;
+}
+
+std::string avatar_file_topology(const std::string& path) {
+  auto read = [&] {
+    const io::Hdf5File f(path, io::Hdf5File::Mode::Read);
+    if (f.has("/meta/topology_hash")) return f.read_string("/meta/topology_hash");
+    if (!f.has("/tet/elements")) fail(path, ": not an avatar file (dataset /tet/elements is missing)");
+    return tet_topology_hash(f.read_int_matrix("/tet/elements", -1, 4));
+  };
+  return io::read_in_child_first(path, read);  // a file that crashes libhdf5 is refused (io/crash_isolation.hpp)
+}
+
+void check_batch_topology(const std::string& out_dir, const std::string& expected, const std::string& expected_from) {
+  std::error_code ec;
+  if (!fs::is_directory(out_dir, ec)) return;
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(out_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("avatar-", 0) == 0 && name.size() > 3 && name.compare(name.size() - 3, 3, ".h5") == 0)
+      files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::string first_file, first;
+  for (const std::string& file : files) {
+    std::string h;
+    try {
+      h = avatar_file_topology(file);
+    } catch (const Error&) {
+      continue;  // not a readable avatar (an interrupted copy, say): plan_batch has it rebuilt
+    }
+    if (first_file.empty()) {
+      first_file = file, first = h;
+    } else if (h != first) {
+      fail("batch: ", first_file, " and ", file, " have different tet topologies (element array hashes ", first,
+           " and ", h, "): every avatar of a batch must share one; build into an empty --out-dir");
+    }
+  }
+  if (!expected.empty() && !first_file.empty() && first != expected)
+    fail("batch: ", first_file, " has tet topology ", first, " but this run's avatars have ", expected, " (",
+         expected_from, "): every avatar of a batch must share one; build into an empty --out-dir");
+}
+
+void verify_batch_manifest(const std::string& path) {
+  for (const BatchRecord& r : read_batch_manifest(path)) {
+    std::error_code ec;
+    if (r.topology.empty() || r.file.empty() || !fs::exists(r.file, ec)) continue;
+    const std::string actual = avatar_file_topology(r.file);
+    if (actual != r.topology)
+      fail(path, ":", r.manifest_line, ": row ", r.row, ": ", r.file, " has tet topology ", actual,
+           " but the manifest records ", r.topology);
+  }
 }
 
 std::string batch_summary(const std::vector<BatchRecord>& records, double wall_s) {

@@ -36,7 +36,9 @@ std::string template_cache_key(const BodyModel& model, const TemplateOptions& o)
     << o.mesh.cell_radius_edge_ratio << '|' << o.mesh.cell_size << '|' << o.mesh.relative_error_bound << '|'
     << o.mesh.perturb_sliver_bound_deg << '|' << o.mesh.exude_sliver_bound_deg << '|'
     << o.mesh.remove_boundary_slivers_below_deg << '|' << o.mesh.seed << '|' << o.sliver_repair.target_deg << '|'
-    << o.sliver_repair.passes << '|' << o.skinned_size_scale << '|' << o.skinned_facet_distance << '|' << o.inner_facet_distance;
+    << o.sliver_repair.passes << '|' << o.skinned_size_scale << '|' << o.skinned_facet_distance << '|' << o.inner_facet_distance
+    << "|topology," << o.topology.directions << ',' << o.topology.range << ',' << o.topology.floor_deg << ','
+    << o.topology.flip_target_deg << ',' << o.topology.rounds;
   Fnv1a64 h;
   h.add(s.str());
   return h.hex();
@@ -46,8 +48,8 @@ namespace {
 
 // Skin thickness at each node: distance to its skeleton point (handles go
 // where the flesh is thick: belly, buttocks, thighs, ...).
-VecX node_thickness(const TemplateVolume& tv, const VecXi& template_nodes, const Avatar& a) {
-  const Points skeleton = tv.node_skeleton_coefficients(template_nodes, Eigen::all) * a.joints_rest;
+VecX node_thickness(const TemplateVolume& tv, const Avatar& a) {
+  const Points skeleton = tv.node_skeleton_coefficients * a.joints_rest;
   return (a.tet.nodes - skeleton).rowwise().norm();
 }
 
@@ -146,7 +148,7 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   const VecXi node_region = basis::node_regions_from_tets(a.tet, a.tet_region, num_regions);
   basis::HandleSet handles = options.handle_positions.rows() > 0
                                  ? basis::snap_handles(a.tet, a.node_role, options.handle_positions)
-                                 : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, shaped.template_nodes, a),
+                                 : basis::select_handles(a.tet, a.node_role, options.handles, node_thickness(tv, a),
                                                          node_region, options.placement);
   a.handles = handles.positions;
   r.handles_s = t.seconds();

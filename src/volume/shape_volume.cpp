@@ -1,15 +1,12 @@
 #include "sflsh/volume/shape_volume.hpp"
 
 #include <algorithm>
-#include <numeric>
 #include <sstream>
 
 #include "sflsh/body/body_model_io.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/meshing/surface_checks.hpp"
-#include "sflsh/mesh/boundary_caps.hpp"
-#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/point_embedding.hpp"
 #include "sflsh/volume/surface_query.hpp"
@@ -23,12 +20,6 @@ std::string ShapeReport::describe() const {
      << seconds << " s";
   if (num_relaxed_nodes > 0) os << "; thickness scale relaxed at " << num_relaxed_nodes << " nodes";
   if (untangled_nodes > 0) os << "; displacement made harmonic at " << untangled_nodes << " folded nodes";
-  if (caps_removed > 0) os << "; " << caps_removed << " flattened skin caps removed";
-  if (flips.flips_2_2 > 0) os << "; " << flips.flips_2_2 << " skin edges flipped (boundary 2-2)";
-  if (ears_removed > 0) os << "; " << ears_removed << " flattened skin ears removed with their apex node";
-  if (flips.flips_2_3 + flips.flips_3_2 > 0)
-    os << "; " << flips.flips_2_3 << " 2-3 and " << flips.flips_3_2 << " 3-2 flips (min dihedral "
-       << flips.min_dihedral_before << " -> " << flips.min_dihedral_after << " deg)";
   if (smoothing.passes > 0)
     os << "\n  interior optimization: min dihedral " << smoothing.min_dihedral_before << " -> "
        << smoothing.min_dihedral_after << " deg, tets below " << smoothing.below_target_before << " -> "
@@ -38,6 +29,9 @@ std::string ShapeReport::describe() const {
     os << "; with skin nodes sliding on the skin: min dihedral " << skin_smoothing.min_dihedral_after << " deg, "
        << skin_smoothing.below_target_after << " tets below target, " << skin_smoothing.nodes_moved
        << " nodes moved (max " << skin_smoothing.max_displacement * 1e3 << " mm)";
+  if (wide_skin_smoothing.passes > 0)
+    os << "; sliding further: min dihedral " << wide_skin_smoothing.min_dihedral_after << " deg, "
+       << wide_skin_smoothing.nodes_moved << " nodes moved";
   if (skin_self_intersects == 1)
     os << "\n  the shaped skin self-intersects (the body model gives no valid solid at these betas)";
   return os.str();
@@ -72,8 +66,8 @@ VecX node_thickness_scale(const TemplateVolume& tv, const ThicknessMap& map, int
 
 }  // namespace
 
-ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
-                          const ThicknessMap& thickness, const ShapeOptions& o) {
+ShapedNodes place_shape_nodes(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                              const ThicknessMap& thickness, const ShapeOptions& o) {
   Timer timer;
   const std::string hash = body_model_hash(model);
   require(hash == tv.model_hash, "shape_volume: the template volume was built for body model ", tv.model_hash,
@@ -83,10 +77,12 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   require(tv.node_face.size() == N && tv.node_face.maxCoeff() < F.rows(),
           "shape_volume: template node faces do not match the model's ", F.rows(), " faces");
 
-  ShapedVolume out;
-  Avatar& av = out.avatar;
-  const Points v_shaped = shape_vertices(model, betas);
-  const Points joints = regress_joints(model, v_shaped);
+  ShapedNodes out;
+  out.v_shaped = shape_vertices(model, betas);
+  out.joints = regress_joints(model, out.v_shaped);
+  const Points& v_shaped = out.v_shaped;
+  const Points& joints = out.joints;
+  TetMesh mesh;  // the template's connectivity, never changed here
 
   // Thickness scale k per node; the depth d' = 1 - k (1 - d) keeps the skin
   // (d = 1) fixed and scales the soft layer. Thickening is capped per node
@@ -134,14 +130,14 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   }
 
   // Places the nodes for a per-node thickness scale k.
-  av.tet.elements = tv.tet.elements;
-  av.tet.nodes.resize(N, 3);
+  mesh.elements = tv.tet.elements;
+  mesh.nodes.resize(N, 3);
   out.node_depth.resize(N);
   auto place = [&](const VecX& k) {
     for (int n = 0; n < N; ++n) {
       const double d = 1.0 - k[n] * (1.0 - tv.node_depth[n]);
       out.node_depth[n] = d;
-      av.tet.nodes.row(n) = sb.row(n) + d * (gb.row(n) - sb.row(n)) + residual.row(n);
+      mesh.nodes.row(n) = sb.row(n) + d * (gb.row(n) - sb.row(n)) + residual.row(n);
     }
   };
   // Where converging paths (crotch, armpits, between fingers) make the
@@ -155,7 +151,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   place(VecX::Ones(N));
   std::vector<double> floor_deg(tv.tet.num_elements());
   for (int t = 0; t < tv.tet.num_elements(); ++t)
-    floor_deg[t] = std::min(o.min_dihedral_deg, tet_quality(av.tet, t).min_dihedral_deg);
+    floor_deg[t] = std::min(o.min_dihedral_deg, tet_quality(mesh, t).min_dihedral_deg);
   VecX relax = VecX::Ones(N);
   std::vector<std::vector<int>> nbr;
   for (int round = 0;; ++round) {
@@ -163,7 +159,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     place(out.node_thickness_scale);
     std::vector<int> bad;
     for (int t = 0; t < tv.tet.num_elements(); ++t)
-      if (const TetQuality q = tet_quality(av.tet, t); q.signed_volume <= 0 || q.min_dihedral_deg < floor_deg[t] - 1e-9)
+      if (const TetQuality q = tet_quality(mesh, t); q.signed_volume <= 0 || q.min_dihedral_deg < floor_deg[t] - 1e-9)
         bad.push_back(t);
     if (bad.empty() || round >= o.max_relax_rounds) break;
     if (nbr.empty()) nbr = tet_node_neighbours(tv.tet);
@@ -199,7 +195,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     std::vector<char> region(N, 0);
     int folded = 0;
     for (int t = 0; t < tv.tet.num_elements(); ++t) {
-      if (tet_quality(av.tet, t).signed_volume > 0) continue;
+      if (tet_quality(mesh, t).signed_volume > 0) continue;
       bool off_skin = false;
       for (int i = 0; i < 4; ++i) off_skin = off_skin || !on_skin[tv.tet.elements(t, i)];
       if (!off_skin) continue;
@@ -214,7 +210,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
           for (int u : nbr[n]) next[u] = next[u] || !on_skin[u];
       region.swap(next);
     }
-    Points u = av.tet.nodes - tv.tet.nodes;
+    Points u = mesh.nodes - tv.tet.nodes;
     std::vector<int> ids;
     for (int n = 0; n < N; ++n)
       if (region[n]) ids.push_back(n);
@@ -227,7 +223,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
       }
       u.swap(next);
     }
-    for (int n : ids) av.tet.nodes.row(n) = tv.tet.nodes.row(n) + u.row(n);
+    for (int n : ids) mesh.nodes.row(n) = tv.tet.nodes.row(n) + u.row(n);
     out.report.untangled_nodes += int(ids.size());
   }
 
@@ -240,25 +236,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   // skin-only tets, which the template stage cannot move): the skin nodes
   // slide along the skin below.
   const double quality_floor = o.quality_floor_deg;
-  // The template tet each avatar tet comes from; `parent` (#T', indices into
-  // the current tets) of an operation that removes or replaces tets composes into it.
-  std::vector<int> kept_tets(size_t(tv.tet.num_elements()));
-  std::iota(kept_tets.begin(), kept_tets.end(), 0);
-  auto follow = [&](std::vector<int> parent) {
-    for (int& t : parent) t = kept_tets[size_t(t)];
-    kept_tets = std::move(parent);
-  };
-  auto remove_caps = [&] {
-    // Tets with all four nodes on the skin and two faces on it, which the
-    // shape flattened or turned inside out by making a convex ridge of the
-    // skin concave: removed (a boundary edge flip; no node moves).
-    if (!o.remove_bad_caps || o.smoothing.passes == 0) return;
-    std::vector<int> kept;
-    out.report.caps_removed += remove_bad_boundary_caps(av.tet, on_skin, quality_floor, &kept).removed;
-    follow(std::move(kept));
-  };
-  remove_caps();
-  if (o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
+  if (o.smoothing.passes > 0 && tet_quality_report(mesh).min_dihedral_deg < quality_floor) {
     std::vector<NodeFreedom> freedom(N, NodeFreedom::Free);
     Points normals = Points::Zero(N, 3);
     for (int i = 0; i < tv.inner_nodes.size(); ++i) {
@@ -273,69 +251,49 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
     }
     for (int n = 0; n < N; ++n)
       if (on_skin[n]) freedom[n] = NodeFreedom::Fixed;
-    out.report.smoothing = smooth_interior_nodes(av.tet, freedom, normals, o.smoothing);
+    out.report.smoothing = smooth_interior_nodes(mesh, freedom, normals, o.smoothing);
+    // Skin nodes of the tets still below the floor slide along the shaped skin
+    // (each candidate projected onto it), first at most skin_slide_fraction of
+    // their shortest edge, then (what is left are mostly ears of the skin: a
+    // skin node in a single tet, which only moving along the skin can raise)
+    // final_skin_slide_fraction.
     const SurfaceQuery skin(v_shaped, F);
-    InteriorSmoothingOptions so = o.smoothing;
-    so.max_displacement_fraction = o.skin_slide_fraction;
-    if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor) {
-      // Skin nodes of the tets still below the floor slide along the shaped skin.
-      for (int t = 0; t < av.tet.num_elements(); ++t)
-        if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
+    auto slide_skin_of_bad_tets = [&](double reach) {
+      for (int t = 0; t < mesh.num_elements(); ++t)
+        if (tet_quality(mesh, t).min_dihedral_deg < quality_floor)
           for (int i = 0; i < 4; ++i)
-            if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
-      out.report.skin_smoothing = smooth_interior_nodes(av.tet, freedom, normals, so,
-                                                        [&](const Vec3& y) { return skin.closest_point(y); });
-    }
-    remove_caps();
-    if (o.flip_rounds > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
-      // Where no node move helps (tets between two skin patches, ears of the
-      // skin surface), 2-3 and 3-2 flips; then the node moves once more.
-      std::vector<int> parent;
-      out.report.flips = flip_bad_tets(av.tet, o.smoothing.target_deg, o.flip_rounds, &parent);
-      follow(parent);
-      // Skin nodes of the tets still below the floor may slide further.
-      auto slide_skin_of_bad_tets = [&] {
-        for (int t = 0; t < av.tet.num_elements(); ++t)
-          if (tet_quality(av.tet, t).min_dihedral_deg < quality_floor)
-            for (int i = 0; i < 4; ++i)
-              if (on_skin[av.tet.elements(t, i)]) freedom[av.tet.elements(t, i)] = NodeFreedom::Surface;
-        // A wider reach on the skin: what is left are mostly ears (a skin node
-        // in a single tet, its three faces on the skin) that only moving
-        // along the skin can raise.
-        InteriorSmoothingOptions wide = so;
-        wide.max_displacement_fraction = o.final_skin_slide_fraction;
-        smooth_interior_nodes(av.tet, freedom, normals, wide, [&](const Vec3& y) { return skin.closest_point(y); });
-      };
-      if (out.report.flips.min_dihedral_after < quality_floor) slide_skin_of_bad_tets();
-      // Tets below the floor whose skin face is itself a needle or a flat
-      // triangle (no fourth-node position helps): the skin edge they share
-      // is flipped (boundary 2-2 flip; the skin nodes stay, the skin is
-      // retriangulated on them), then the nodes move once more.
-      if (tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
-        out.report.flips.flips_2_2 =
-            flip_bad_boundary_edges(av.tet, on_skin, quality_floor, o.flip_rounds, &parent).flips_2_2;
-        follow(parent);
-        if (out.report.flips.flips_2_2 > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor)
-          slide_skin_of_bad_tets();
-      }
-      remove_caps();
-    }
+            if (on_skin[mesh.elements(t, i)]) freedom[mesh.elements(t, i)] = NodeFreedom::Surface;
+      InteriorSmoothingOptions so = o.smoothing;
+      so.max_displacement_fraction = reach;
+      return smooth_interior_nodes(mesh, freedom, normals, so, [&](const Vec3& y) { return skin.closest_point(y); });
+    };
+    if (o.skin_slide_fraction > 0 && out.report.smoothing.min_dihedral_after < quality_floor)
+      out.report.skin_smoothing = slide_skin_of_bad_tets(o.skin_slide_fraction);
+    if (o.final_skin_slide_fraction > 0 && tet_quality_report(mesh).min_dihedral_deg < quality_floor)
+      out.report.wide_skin_smoothing = slide_skin_of_bad_tets(o.final_skin_slide_fraction);
   }
-  // Ears still below the floor (a skin node in a single tet, its three faces
-  // on the skin, flattened where the shape flattens the skin under it): no
-  // move along the skin raises them, so they go with their apex node.
-  VecXi& tn = out.template_nodes;
-  tn = VecXi::LinSpaced(N, 0, N - 1);
-  if (o.remove_bad_caps && o.smoothing.passes > 0 && tet_quality_report(av.tet).min_dihedral_deg < quality_floor) {
-    std::vector<int> kept, nodes;
-    out.report.ears_removed = remove_bad_boundary_ears(av.tet, on_skin, quality_floor, &kept, &nodes).removed;
-    if (out.report.ears_removed > 0) {
-      follow(std::move(kept));
-      tn = Eigen::Map<const VecXi>(nodes.data(), Eigen::Index(nodes.size()));
-    }
-  }
-  av.tet_region = tv.tet_region(Eigen::Map<const VecXi>(kept_tets.data(), Eigen::Index(kept_tets.size())));
-  out.report.quality = tet_quality_report(av.tet);
+  out.report.quality = tet_quality_report(mesh);
+  out.nodes = std::move(mesh.nodes);
+  out.node_skeleton = std::move(sb);
+  out.report.seconds = timer.seconds();
+  return out;
+}
+
+ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                          const ThicknessMap& thickness, const ShapeOptions& o) {
+  Timer timer;
+  ShapedNodes placed = place_shape_nodes(tv, model, betas, thickness, o);
+  ShapedVolume out;
+  out.report = placed.report;
+  out.node_depth = std::move(placed.node_depth);
+  out.node_thickness_scale = std::move(placed.node_thickness_scale);
+  const Points& v_shaped = placed.v_shaped;
+  const Points& joints = placed.joints;
+  const Triangles& F = model.faces;
+  Avatar& av = out.avatar;
+  av.tet.nodes = std::move(placed.nodes);
+  av.tet.elements = tv.tet.elements;  // one connectivity for every shape (seed §4)
+  av.tet_region = tv.tet_region;
   if (out.report.quality.num_inverted > 0 || out.report.quality.min_dihedral_deg < o.quality_floor_deg)
     out.report.skin_self_intersects = check_surface(v_shaped, F, true).self_intersects ? 1 : 0;
   require(out.report.quality.num_inverted == 0, "shape_volume: ",
@@ -348,7 +306,7 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
 
   // Meta, skeleton, skin.
   av.betas = betas;
-  av.model_hash = hash;
+  av.model_hash = tv.model_hash;
   av.model_source = model.source;
   av.joints_rest = joints;
   av.parents = model.parents;
@@ -363,25 +321,14 @@ ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, cons
   out.report.max_embedding_distance = emb.distance.maxCoeff();
   out.report.num_embedded_outside = emb.num_outside;
 
-  // Volume fields: the template's per-node fields at the avatar's nodes.
-  const int N_av = int(tn.size());
-  VecXi new_index = VecXi::Constant(N, -1);
-  for (int i = 0; i < N_av; ++i) new_index[tn[i]] = i;
-  std::vector<int> outer;
-  for (int i = 0; i < tv.outer_nodes.size(); ++i)
-    if (new_index[tv.outer_nodes[i]] >= 0) outer.push_back(new_index[tv.outer_nodes[i]]);
-  const VecXi outer_nodes = Eigen::Map<const VecXi>(outer.data(), Eigen::Index(outer.size()));
-  const Points sb_av = sb(tn, Eigen::all);
-  const VecXi node_segment = tv.node_segment(tn);
-  av.node_weights = tv.node_weights(tn, Eigen::all);
-  av.node_role = tv.node_role(tn);
-  av.surface_nodes = outer_nodes;
-  out.node_depth = VecX(out.node_depth(tn));
-  out.node_thickness_scale = VecX(out.node_thickness_scale(tn));
+  // Volume fields: the template's per-node fields.
+  av.node_weights = tv.node_weights;
+  av.node_role = tv.node_role;
+  av.surface_nodes = tv.outer_nodes;
   av.materials = default_region_materials();
-  av.tet_frames = tet_frames(av.tet, sb_av, node_segment, tv.segments, model.parents, joints);
-  av.capsules = fit_bone_capsules(av.tet.nodes, sb_av, outer_nodes, node_segment, tv.segments, model.parents, joints,
-                                  o.capsule_percentile);
+  av.tet_frames = tet_frames(av.tet, placed.node_skeleton, tv.node_segment, tv.segments, model.parents, joints);
+  av.capsules = fit_bone_capsules(av.tet.nodes, placed.node_skeleton, tv.outer_nodes, tv.node_segment, tv.segments,
+                                  model.parents, joints, o.capsule_percentile);
   out.report.seconds = timer.seconds();
   return out;
 }

@@ -16,6 +16,7 @@
 #include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/volume/body_regions.hpp"
 #include "sflsh/volume/surface_query.hpp"
+#include "sflsh/volume/topology_design.hpp"
 
 namespace sflsh {
 namespace {
@@ -75,6 +76,38 @@ VecX skinned_joint_weight(const BodyModel& model) {
   return w;
 }
 
+/// The skin -> tet outer boundary distances of TemplateReport (the faces of
+/// tv's tet boundary with three skin nodes against the model's template skin).
+void measure_skin_fidelity(const TemplateVolume& tv, const BodyModel& model, const VecX& skinned_weight,
+                           double skinned_weight_threshold, TemplateReport& rep) {
+  const Points& V = model.v_template;
+  const Triangles B = tet_boundary_faces(tv.tet);
+  std::vector<char> outer(size_t(tv.tet.num_nodes()), 0);
+  for (Eigen::Index i = 0; i < tv.outer_nodes.size(); ++i) outer[size_t(tv.outer_nodes[i])] = 1;
+  std::vector<std::array<int, 3>> of;
+  for (int f = 0; f < B.rows(); ++f)
+    if (outer[B(f, 0)] && outer[B(f, 1)] && outer[B(f, 2)]) of.push_back({B(f, 0), B(f, 1), B(f, 2)});
+  require(!of.empty(), "template stage: the tet mesh has no boundary on the skin");
+  Triangles OF(of.size(), 3);
+  for (size_t i = 0; i < of.size(); ++i) OF.row(i) << of[i][0], of[i][1], of[i][2];
+  const SurfaceQuery boundary_query(tv.tet.nodes, OF);
+  rep.skin_to_outer_boundary = rep.skin_to_outer_boundary_simulated = 0;
+  rep.worst_skin_vertex = rep.worst_simulated_skin_vertex = -1;
+  for (int v = 0; v < model.num_vertices(); ++v) {
+    const double d = boundary_query.distance(V.row(v));
+    int dom = 0;
+    model.weights.row(v).maxCoeff(&dom);
+    if (d > rep.skin_to_outer_boundary)
+      rep.skin_to_outer_boundary = d, rep.worst_skin_vertex = v, rep.worst_skin_joint = dom;
+    if (skinned_weight[v] < skinned_weight_threshold && d > rep.skin_to_outer_boundary_simulated)
+      rep.skin_to_outer_boundary_simulated = d, rep.worst_simulated_skin_vertex = v,
+      rep.worst_simulated_skin_joint = dom;
+  }
+  if (rep.worst_skin_vertex >= 0) rep.worst_skin_position = V.row(rep.worst_skin_vertex).transpose();
+  if (rep.worst_simulated_skin_vertex >= 0)
+    rep.worst_simulated_skin_position = V.row(rep.worst_simulated_skin_vertex).transpose();
+}
+
 }  // namespace
 
 std::string TemplateReport::describe() const {
@@ -92,10 +125,11 @@ std::string TemplateReport::describe() const {
      << "  time: correspondence " << correspondence_s << " s, meshing " << mesh_s << " s (refine "
      << mesh.refine_s << ", odt " << mesh.odt_s << ", perturb " << mesh.perturb_s << ", exude " << mesh.exude_s
      << "), extension "
-     << extension_s << " s, total " << total_s << " s\n"
+     << extension_s << " s, topology design " << topology_s << " s, total " << total_s << " s\n"
      << "  sliver repair: " << sliver_repair.slivers_before << " -> " << sliver_repair.slivers_after
      << " tets below target, min dihedral " << sliver_repair.min_dihedral_before << " -> "
-     << sliver_repair.min_dihedral_after << " deg (" << sliver_repair.moves << " node moves)";
+     << sliver_repair.min_dihedral_after << " deg (" << sliver_repair.moves << " node moves)\n  "
+     << topology.describe();
   return os.str();
 }
 
@@ -235,28 +269,7 @@ TemplateVolume build_template_volume(const BodyModel& model, const TemplateOptio
   tv.inner_nodes = Eigen::Map<VecXi>(inner_list.data(), inner_list.size());
   rep.num_outer_nodes = int(outer_list.size());
   rep.num_inner_nodes = int(inner_list.size());
-  {
-    std::vector<std::array<int, 3>> of;
-    for (int f = 0; f < B.rows(); ++f)
-      if (outer[B(f, 0)] && outer[B(f, 1)] && outer[B(f, 2)]) of.push_back({B(f, 0), B(f, 1), B(f, 2)});
-    require(!of.empty(), "template stage: the tet mesh has no boundary on the skin");
-    Triangles OF(of.size(), 3);
-    for (size_t i = 0; i < of.size(); ++i) OF.row(i) << of[i][0], of[i][1], of[i][2];
-    const SurfaceQuery boundary_query(tv.tet.nodes, OF);
-    for (int v = 0; v < nV; ++v) {
-      const double d = boundary_query.distance(V.row(v));
-      int dom = 0;
-      model.weights.row(v).maxCoeff(&dom);
-      if (d > rep.skin_to_outer_boundary)
-        rep.skin_to_outer_boundary = d, rep.worst_skin_vertex = v, rep.worst_skin_joint = dom;
-      if (skinned_weight[v] < o.skinned_weight_threshold && d > rep.skin_to_outer_boundary_simulated)
-        rep.skin_to_outer_boundary_simulated = d, rep.worst_simulated_skin_vertex = v,
-        rep.worst_simulated_skin_joint = dom;
-    }
-    if (rep.worst_skin_vertex >= 0) rep.worst_skin_position = V.row(rep.worst_skin_vertex).transpose();
-    if (rep.worst_simulated_skin_vertex >= 0)
-      rep.worst_simulated_skin_position = V.row(rep.worst_simulated_skin_vertex).transpose();
-  }
+  measure_skin_fidelity(tv, model, skinned_weight, o.skinned_weight_threshold, rep);
 
   // 4. Node correspondence: find the skin point σ whose path s(σ) -> σ passes
   // through the node (seed §2 "following the correspondence path").
@@ -390,6 +403,21 @@ TemplateVolume build_template_volume(const BodyModel& model, const TemplateOptio
     tv.tet_region[t] = body_region_of(dom, facing, c.y() / 4.0 - J0(dom, 1));
   }
   rep.extension_s = timer.seconds();
+
+  // 8. One connectivity for every shape (seed §4): the repairs the shapes
+  // need beyond node moves, made once here (volume/topology_design.hpp).
+  // The figures above that depend on the tets are measured again after it.
+  timer.reset();
+  rep.topology = design_template_topology(tv, model, o.topology);
+  if (tv.tet.num_elements() != rep.topology.tets_before || tv.tet.num_nodes() != rep.topology.nodes_before ||
+      rep.topology.rounds > 0) {
+    rep.mesh.quality = tet_quality_report(tv.tet, rep.mesh.quality.sliver_threshold_deg);
+    rep.num_outer_nodes = int(tv.outer_nodes.size());
+    rep.num_inner_nodes = int(tv.inner_nodes.size());
+    rep.num_skinned_nodes = int((tv.node_role.array() == int(NodeRole::Skinned)).count());
+    measure_skin_fidelity(tv, model, skinned_weight, o.skinned_weight_threshold, rep);
+  }
+  rep.topology_s = timer.seconds();
   rep.total_s = total.seconds();
   return tv;
 }

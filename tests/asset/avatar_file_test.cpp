@@ -6,6 +6,7 @@
 #include "sflsh/body/smpl_skeleton.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 #include "test_support.hpp"
 
 using namespace sflsh;
@@ -155,4 +156,29 @@ TEST(AvatarFile, RejectsNonFiniteNodes) {
   std::string err = error_of([&] { read_avatar(tmp.file("n.h5")); });
   EXPECT_NE(err.find("/surface/vertices"), std::string::npos) << err;
   EXPECT_NE(err.find("non-finite"), std::string::npos) << err;
+}
+
+// /meta/topology_hash: the element array's hash (FNV-1a 64 over the int32 indices, by hand
+// below), checked on reading; a file without it (written before it existed) still reads.
+TEST(AvatarFile, TopologyHashIsStoredCheckedAndOptional) {
+  test::TempDir tmp;
+  const Avatar a = tiny_avatar();
+  write_avatar(a, tmp.file("t.h5"));
+  {
+    io::Hdf5File f(tmp.file("t.h5"), io::Hdf5File::Mode::Read);
+    EXPECT_EQ(f.read_string("/meta/topology_hash"), tet_topology_hash(a.tet.elements));
+  }
+  std::string out;
+  auto python = [&](const std::string& code) {
+    return test::run_command("/usr/bin/python3 -c \"import h5py, sys\nwith h5py.File(sys.argv[1], 'r+') as f:\n" +
+                                 code + "\" " + tmp.file("t.h5"),
+                             &out);
+  };
+  // Tets in the other order: the stored hash no longer matches.
+  ASSERT_EQ(python("    e = f['/tet/elements'][...]\n    e[[0, 1]] = e[[1, 0]]\n    f['/tet/elements'][...] = e"), 0)
+      << out;
+  EXPECT_NE(error_of([&] { read_avatar(tmp.file("t.h5")); }).find("dataset /meta/topology_hash is "),
+            std::string::npos);
+  ASSERT_EQ(python("    del f['/meta/topology_hash']"), 0) << out;
+  EXPECT_EQ(read_avatar(tmp.file("t.h5")).tet.elements.row(0), a.tet.elements.row(1));
 }

@@ -4,6 +4,7 @@
 // and the Dask driver (data_tools/batch_precompute_dask.py) on a LocalCluster.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -14,6 +15,7 @@
 #include "sflsh/basis/basis_coverage.hpp"
 #include "sflsh/basis/handle_placement.hpp"
 #include "sflsh/body/body_model_io.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 #include "sflsh/precompute/batch_precompute.hpp"
 #include "test_support.hpp"
 
@@ -264,4 +266,60 @@ TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
   const VecX b = VecX::Zero(10);
   EXPECT_NE(avatar_content_key(model, b, o2), avatar_content_key(model, b, o3));
   EXPECT_NE(avatar_content_key(model, b, o2), avatar_content_key(model, b, o4));
+}
+
+// One tet topology per batch folder (seed §4). Every output's element array hash is in the
+// manifest and in the file's /meta/topology_hash; a manifest row whose hash is not its file's
+// is refused with one line naming the manifest line, the row and the file; a folder holding an
+// avatar with other tets (an older file: no /meta/topology_hash, two tets swapped) is refused
+// with one line naming both files, before anything is built.
+TEST_F(BatchCli, AWrongManifestHashAndAFolderWithTwoTopologiesAreRefused) {
+  const std::string shapes = csv("topo.csv", "b0,b1\n0.5,0\n");
+  const std::string out_dir = dir_->file("topo");
+  std::string out;
+  ASSERT_EQ(run("--batch " + shapes + " --out-dir " + out_dir + " --jobs 1", &out), 0) << out;
+  const std::string path = out_dir + "/manifest.csv";
+  auto m = manifest(path);
+  ASSERT_EQ(m[0].status, "built");
+  const std::string file = m[0].file, hash = m[0].topology;
+  ASSERT_EQ(hash.size(), 16u);
+  EXPECT_EQ(hash, tet_topology_hash(read_avatar(file).tet.elements));
+  const std::string text = bytes(path);
+
+  // The manifest's row 0 records another hash.
+  std::string bad = text;
+  ASSERT_NE(bad.find("," + hash + ","), std::string::npos);
+  bad.replace(bad.find("," + hash + ","), hash.size() + 2, ",0123456789abcdef,");
+  std::ofstream(path) << bad;
+  EXPECT_NE(run("--batch " + shapes + " --out-dir " + out_dir, &out), 0);
+  EXPECT_NE(out.find(path + ":2: row 0: " + file + " has tet topology " + hash +
+                     " but the manifest records 0123456789abcdef"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << "one line:\n" << out;
+  EXPECT_EQ(bytes(path), bad) << "the refused run rewrote the manifest";
+  std::ofstream(path) << text;
+
+  // A second avatar with other tets in the folder.
+  const std::string other = out_dir + "/avatar-0000000000000000.h5";
+  fs::copy_file(file, other);
+  ASSERT_EQ(test::run_command("/usr/bin/python3 -c \"import h5py, sys\n"
+                              "with h5py.File(sys.argv[1], 'r+') as f:\n"
+                              "    e = f['/tet/elements'][...]\n"
+                              "    e[[0, 1]] = e[[1, 0]]\n"
+                              "    f['/tet/elements'][...] = e\n"
+                              "    del f['/meta/topology_hash']\" " +
+                                  other,
+                              &out),
+            0)
+      << out;
+  const std::string more = csv("topo2.csv", "b0,b1\n0.5,0\n-0.5,0\n");
+  EXPECT_NE(run("--batch " + more + " --out-dir " + out_dir, &out), 0);
+  EXPECT_NE(out.find("batch: " + other + " and " + file + " have different tet topologies"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << "one line:\n" << out;
+  EXPECT_EQ(bytes(path), text) << "nothing written";
+  EXPECT_EQ(manifest(path).size(), 1u);
+  int avatars = 0;
+  for (const auto& e : fs::directory_iterator(out_dir)) avatars += e.path().extension() == ".h5";
+  EXPECT_EQ(avatars, 2) << "the second row was not built";
 }

@@ -135,5 +135,37 @@ TEST(BoundaryEars, KeepsGoodEarsEarsOffTheSurfaceAndPinchedApexes) {
   EXPECT_THROW(remove_bad_boundary_ears(pinched, std::vector<char>(3, 1), 8.0), Error);
 }
 
+// Judged at several shapes: a cap that is good in the reference geometry (h = 1) but inverted
+// in another shape (c, d pushed below the diagonal) goes, and the reference keeps no inverted tet.
+TEST(BoundaryCaps, ACapBadInOneShapeGoesWhenJudgedOverAllShapes) {
+  const TetMesh good = roof(1.0);
+  Points concave = good.nodes;
+  concave(2, 2) = concave(3, 2) = -0.05;
+  Tets e = good.elements;
+  EXPECT_EQ(remove_bad_boundary_caps(e, GeometrySet{good.nodes}, std::vector<char>(5, 1), 8.0).removed, 0);
+  std::vector<int> kept;
+  EXPECT_EQ(remove_bad_boundary_caps(e, GeometrySet{good.nodes, concave}, std::vector<char>(5, 1), 8.0, &kept).removed,
+            1);
+  EXPECT_EQ(kept, (std::vector<int>{1, 2}));
+  EXPECT_EQ(tet_quality_report(TetMesh{good.nodes, e}).num_inverted, 0);
+  EXPECT_EQ(tet_quality_report(TetMesh{concave, e}).num_inverted, 0);
+}
+
+// An ear that is fine in the reference geometry and flat in another shape goes with its apex;
+// the tets are renumbered, the geometries are left to the caller (kept_nodes).
+TEST(BoundaryEars, AnEarFlatInOneShapeGoesWhenJudgedOverAllShapes) {
+  const TetMesh good = mesh_with_ear(0.5), flat = mesh_with_ear(0.01);
+  Tets e = good.elements;
+  std::vector<int> kept_tets, kept_nodes;
+  EXPECT_EQ(remove_bad_boundary_ears(e, GeometrySet{good.nodes}, std::vector<char>(6, 1), 8.0).removed, 0);
+  const BoundaryCapReport r = remove_bad_boundary_ears(e, GeometrySet{good.nodes, flat.nodes}, std::vector<char>(6, 1),
+                                                       8.0, &kept_tets, &kept_nodes);
+  EXPECT_EQ(r.removed, 1);
+  EXPECT_EQ(kept_tets, (std::vector<int>{0, 1}));
+  EXPECT_EQ(kept_nodes, (std::vector<int>{0, 1, 3, 4, 5}));
+  EXPECT_EQ(e.rows(), 2);
+  EXPECT_EQ(e.maxCoeff(), 4);
+}
+
 }  // namespace
 }  // namespace sflsh

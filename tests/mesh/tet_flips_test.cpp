@@ -137,5 +137,52 @@ TEST(TetFlips, BoundaryTwoTwoFlipNeedsSurfaceNodesAndAConvexQuad) {
   EXPECT_THROW(flip_bad_boundary_edges(m, std::vector<char>(4, 1), 8.0), Error);
 }
 
+// The template stage's rule: a flip judged at several body shapes at once. Shape A is the sliver
+// of TwoThreeFlipReplacesASliverOnAFace, where the 2-3 flip helps; in shape B the apex a sits
+// at (0.9, 0.9, 0.5), so the new edge a-e crosses the plane of the triangle at (0.7, 0.7)
+// (by hand: a + (e - a) / 3), outside it: a new tet would be inverted in B (its old two are
+// fine there). Judged at A alone the flip is made; at A and B it must be refused.
+TEST(TetFlips, AFlipThatHelpsOneShapeButInvertsAnotherIsRefused) {
+  const TetMesh a = two_tets(Vec3(0.3, 0.3, 0.02), Vec3(0.3, 0.3, -1));
+  Points b = a.nodes;
+  b.row(3) << 0.9, 0.9, 0.5;
+  ASSERT_GT(tet_quality(TetMesh{b, a.elements}, 0).signed_volume, 0);
+  ASSERT_GT(tet_quality(TetMesh{b, a.elements}, 1).signed_volume, 0);
+  Tets e = a.elements;
+  EXPECT_EQ(flip_bad_tets(e, GeometrySet{a.nodes}, 30.0).flips_2_3, 1);
+  EXPECT_EQ(e.rows(), 3);
+  e = a.elements;
+  const TetFlipReport r = flip_bad_tets(e, GeometrySet{a.nodes, b}, 30.0);
+  EXPECT_EQ(r.flips_2_3 + r.flips_3_2, 0);
+  EXPECT_EQ(e, a.elements);
+  // A shape C where the flip only lowers the angles (a over (0.45, 0.45), still inside the
+  // triangle): allowed as long as C stays above the cap, refused with a cap above C's old minimum.
+  Points c = a.nodes;
+  c.row(3) << 0.45, 0.45, 0.6;
+  std::vector<TetNodes> old = {{0, 1, 2, 3}, {0, 1, 2, 4}}, fresh = {{0, 1, 3, 4}, {1, 2, 3, 4}, {2, 0, 3, 4}};
+  ASSERT_TRUE(orient_at_reference({a.nodes}, old));
+  ASSERT_TRUE(orient_at_reference({a.nodes}, fresh));
+  const double old_c = worst_dihedral_deg(c, old), fresh_c = worst_dihedral_deg(c, fresh);
+  ASSERT_GT(fresh_c, 5.0);
+  ASSERT_LT(fresh_c, old_c) << "the flip lowers C";
+  e = a.elements;
+  EXPECT_EQ(flip_bad_tets(e, GeometrySet{a.nodes, c}, fresh_c - 1).flips_2_3, 1) << "C stays above the cap";
+  e = a.elements;
+  EXPECT_EQ(flip_bad_tets(e, GeometrySet{a.nodes, c}, old_c + 1).flips_2_3, 0) << "C would get worse";
+}
+
+// The boundary 2-2 flip of the needle, judged with a second shape where a has moved to the
+// other side of r (the quad not convex there): the new tets would overlap in that shape.
+TEST(TetFlips, BoundaryTwoTwoFlipIsRefusedWhenAnotherShapeMakesTheQuadNonConvex) {
+  const TetMesh m = needle_on_the_surface();
+  Points bent = m.nodes;
+  bent.row(0) << 1.5, 0.05, 0;
+  Tets e = m.elements;
+  EXPECT_EQ(flip_bad_boundary_edges(e, GeometrySet{m.nodes}, std::vector<char>(5, 1), 8.0).flips_2_2, 1);
+  e = m.elements;
+  EXPECT_EQ(flip_bad_boundary_edges(e, GeometrySet{m.nodes, bent}, std::vector<char>(5, 1), 8.0).flips_2_2, 0);
+  EXPECT_EQ(e, m.elements);
+}
+
 }  // namespace
 }  // namespace sflsh

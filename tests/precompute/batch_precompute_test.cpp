@@ -205,15 +205,24 @@ TEST(BatchPlan, MarksInvalidDuplicateDoneAndPendingRows) {
 TEST(BatchManifest, RoundTripsFieldsWithCommasAndQuotes) {
   test::TempDir dir;
   std::vector<BatchRecord> in(2);
-  in[0] = {3, 5, "eve, \"jr\"", "0123456789abcdef", "/x/avatar-0123456789abcdef.h5", "built", 12.3456, 410.26, ""};
+  in[0] = {3, 5, "eve, \"jr\"", "0123456789abcdef", "/x/avatar-0123456789abcdef.h5", "built", 12.3456, 410.26, "",
+           "fedcba9876543210"};
   in[1] = {4, 6, "", "", "", "failed", 0, 0, "column 'b0' 'abc' is not a number, see \"x\""};
   write_batch_manifest(in, dir.file("m.csv"));
   std::ifstream f(dir.file("m.csv"));
   std::string header;
   std::getline(f, header);
-  EXPECT_EQ(header, "row,line,name,key,file,status,seconds,peak_rss_mib,error");
+  EXPECT_EQ(header, "row,line,name,key,file,status,topology,seconds,peak_rss_mib,error");
+  std::string row0;
+  std::getline(f, row0);
+  EXPECT_EQ(row0, "3,5,\"eve, \"\"jr\"\"\",0123456789abcdef,/x/avatar-0123456789abcdef.h5,built,fedcba9876543210,12.346,"
+                  "410.3,");
   const auto out = read_batch_manifest(dir.file("m.csv"));
   ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].topology, "fedcba9876543210");
+  EXPECT_EQ(out[1].topology, "");
+  EXPECT_EQ(out[0].manifest_line, 2);
+  EXPECT_EQ(out[1].manifest_line, 3);
   EXPECT_EQ(out[0].name, in[0].name);
   EXPECT_EQ(out[0].key, in[0].key);
   EXPECT_EQ(out[0].file, in[0].file);
@@ -224,6 +233,18 @@ TEST(BatchManifest, RoundTripsFieldsWithCommasAndQuotes) {
   EXPECT_EQ(out[1].line, 6);
   EXPECT_EQ(out[1].error, in[1].error);
   test::expect_error([&] { read_batch_manifest(write_file(dir, "bad.csv", "a,b\n")); }, {"bad.csv", "not a batch manifest"});
+  // A manifest from before the topology column is still read (no topology recorded).
+  const auto old = read_batch_manifest(write_file(dir, "old.csv",
+                                                  "row,line,name,key,file,status,seconds,peak_rss_mib,error\n"
+                                                  "0,2,a,k,/x/f.h5,built,1.5,20.0,\n"));
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].status, "built");
+  EXPECT_EQ(old[0].topology, "");
+  EXPECT_DOUBLE_EQ(old[0].seconds, 1.5);
+  test::expect_error([&] { read_batch_manifest(write_file(dir, "short.csv",
+                                                          "row,line,name,key,file,status,topology,seconds,peak_rss_mib,"
+                                                          "error\n0,2,a,k,/x/f.h5,built,1.5,20.0,\n")); },
+                     {"short.csv:2", "expected 10 fields, found 9"});
 }
 
 TEST(BatchReport, ProgressRateEtaAndSummaryTable) {

@@ -7,13 +7,17 @@
 //
 // Shapes: beta = 0; corners of [-3, 3]^10 (the first 10 betas): every sign pattern of the first
 // 4 with the others at +-3 alternating, both phases (32 corners; "all" = all 1024, "0" = none);
-// each direction alone at -3 and +3 (SFLSH_SWEEP_DIRECTIONS=1); uniform random draws in the box
+// with SFLSH_SWEEP_DIRECTIONS=1 the template stage's design shapes (volume/topology_design.hpp:
+// each direction alone at -3 and +3, all -3, all +3, the two alternating corners); uniform random draws in the box
 // (seed 2026); and the rows of an optional CSV (`name,b0,b1,...`, e.g. the MakeHuman targets
 // from data_tools/makehuman_to_smpl.py --target-betas). Each goes through the shape stage's
 // geometry (shape_volume, default thickness map); every one must keep its minimum dihedral angle
-// >= 8 deg with no inverted tet. Template stage from the precompute cache. One machine-readable
-// line per shape: SWEEP|name|min dihedral deg|inverted|tets below 8 deg|caps removed|seconds|skin
-// self-intersects (yes/no, tested only for shapes below the bar, else -)[|error of a failed shape].
+// >= 8 deg with no inverted tet, on the template's tets (the same element array for every shape).
+// Template stage from the precompute cache. One machine-readable line per shape:
+// SWEEP|name|min dihedral deg|inverted|tets below 8 deg|tets|seconds|skin self-intersects (yes/no,
+// tested only for shapes below the bar, else -)|same tets as the template (yes/no), or for a
+// shape that failed SWEEP|name|failed|-|-|-|seconds|skin self-intersects|error. First a line
+// SWEEP-TEMPLATE|tets|nodes|topology hash|template stage seconds (0 if cached)|design report.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -30,7 +34,9 @@
 #include "sflsh/core/timer.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/volume/body_regions.hpp"
+#include "sflsh/mesh/tet_topology_hash.hpp"
 #include "sflsh/volume/shape_volume.hpp"
+#include "sflsh/volume/topology_design.hpp"
 
 namespace sflsh {
 namespace {
@@ -45,7 +51,14 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
   const BodyModel model = load_body_model(model_env && *model_env ? model_env : "procedural");
   PrecomputeOptions po;
   po.cache_dir = default_cache_dir();
-  const TemplateVolume tv = cached_template_volume(model, po);
+  PrecomputeReport pr;
+  const TemplateVolume tv = cached_template_volume(model, po, &pr);
+  std::string design = tv.report.describe();  // the template report (empty when loaded from the cache)
+  for (char& c : design)
+    if (c == '|' || c == '\n') c = ' ';
+  std::printf("SWEEP-TEMPLATE|%d|%d|%s|%.1f|%s\n", tv.tet.num_elements(), tv.tet.num_nodes(),
+              tet_topology_hash(tv.tet.elements).c_str(), pr.template_from_cache ? 0.0 : pr.template_s,
+              pr.template_from_cache ? "(loaded from the cache)" : design.c_str());
   const int B = model.num_betas(), D = std::min(B, 10);
   const double range = 3.0;
 
@@ -73,14 +86,13 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       ++corners;
     }
   }
-  // Each direction alone at -3 and +3 (SFLSH_SWEEP_DIRECTIONS=1).
-  if (env_int("SFLSH_SWEEP_DIRECTIONS", 0))
-    for (int d = 0; d < D; ++d)
-      for (double v : {-range, range}) {
-        VecX b = VecX::Zero(B);
-        b[d] = v;
-        shapes.emplace_back("beta" + std::to_string(d) + (v > 0 ? "=+3" : "=-3"), b);
-      }
+  // The template stage's design shapes but zero (SFLSH_SWEEP_DIRECTIONS=1).
+  if (env_int("SFLSH_SWEEP_DIRECTIONS", 0)) {
+    TopologyDesignOptions design_options;
+    design_options.range = range;
+    for (const auto& shape : topology_design_shapes(B, design_options))
+      if (shape.first != "zero") shapes.push_back(shape);
+  }
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> U(-range, range);
   for (int i = 0, n = env_int("SFLSH_SWEEP_RANDOM", 100); i < n; ++i) {
@@ -116,8 +128,11 @@ TEST(ShapeQualitySweep, DISABLED_CornersRandomDrawsAndListedShapes) {
       const double sec = t.seconds();
       total_s += sec;
       const int si = s.report.skin_self_intersects;
-      std::printf("SWEEP|%s|%.3f|%d|%d|%d|%.2f|%s\n", name.c_str(), q.min_dihedral_deg, q.num_inverted,
-                  q.num_below_threshold, s.report.caps_removed, sec, si < 0 ? "-" : si ? "yes" : "no");
+      const bool same_tets = s.avatar.tet.elements == tv.tet.elements;
+      std::printf("SWEEP|%s|%.3f|%d|%d|%d|%.2f|%s|%s\n", name.c_str(), q.min_dihedral_deg, q.num_inverted,
+                  q.num_below_threshold, s.avatar.tet.num_elements(), sec, si < 0 ? "-" : si ? "yes" : "no",
+                  same_tets ? "yes" : "no");
+      EXPECT_TRUE(same_tets) << name << ": the shape stage changed the tets";
       std::fflush(stdout);
       std::printf("%-24s min dihedral %6.3f deg (before the interior optimization %6.3f), %d below 8, %d inverted, "
                   "%d nodes moved, %d tets below target on fixed nodes only, %d skin nodes slid (max %.2f mm), %.2f s\n",

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <numeric>
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/body_model_io.hpp"
@@ -16,6 +18,7 @@
 #include "sflsh/volume/shape_volume.hpp"
 #include "sflsh/volume/surface_query.hpp"
 #include "sflsh/volume/template_volume.hpp"
+#include "sflsh/volume/topology_design.hpp"
 #include "test_support.hpp"
 
 namespace sflsh {
@@ -118,6 +121,9 @@ TemplateOptions coarse_options() {
   // Uniform sizes (the sizing field has its own test below).
   o.skinned_size_scale = 1.0;
   o.skinned_facet_distance = o.inner_facet_distance = 0.0;
+  // The capsule's shapes scale its radius by 1 + 0.2 β0: the design box is the range its tests
+  // shape it over (|β| <= 2; at β0 = -3 the tube would shrink to 40 %).
+  o.topology.range = 2.0;
   return o;
 }
 
@@ -331,6 +337,11 @@ TEST(ShapeVolume, NoInvertedTetsOverTheBetaRange) {
     for (const ThicknessMap& map : {ThicknessMap::uniform(), thick}) {
       const ShapedVolume s = shape_volume(tv, body(), beta, map);
       EXPECT_EQ(s.report.quality.num_inverted, 0) << beta.transpose();
+      // The shape only moves nodes (with the interior optimization and skin sliding on):
+      // the template's tets, regions and node count for every shape.
+      EXPECT_TRUE(s.avatar.tet.elements == tv.tet.elements) << beta.transpose();
+      EXPECT_TRUE(s.avatar.tet_region == tv.tet_region) << beta.transpose();
+      EXPECT_EQ(s.avatar.tet.num_nodes(), tv.tet.num_nodes()) << beta.transpose();
       EXPECT_GT(s.report.quality.min_volume, 0.0);
       // Radial growth/stretch by up to 40 % distorts tets a little; the
       // thickness map never takes one below 2 deg (ShapeOptions).
@@ -417,6 +428,88 @@ TEST(TemplateVolume, CacheRoundTripAndCorruptFile) {
   BodyModel other = body();
   other.v_template(0, 0) += 1e-3;
   EXPECT_THROW(shape_volume(tv, other, VecX()), Error);
+}
+
+// The design shapes of the topology design, by hand for a model with 2 shape directions.
+TEST(TopologyDesign, DesignShapesAreZeroEachDirectionAloneTheTwoExtremesAndTheAlternations) {
+  TopologyDesignOptions o;
+  o.range = 3;
+  const auto shapes = topology_design_shapes(2, o);
+  const std::vector<std::pair<std::string, std::vector<double>>> expect = {
+      {"zero", {0, 0}},          {"beta0=-3", {-3, 0}}, {"beta0=+3", {3, 0}},        {"beta1=-3", {0, -3}},
+      {"beta1=+3", {0, 3}},      {"all -3", {-3, -3}},  {"all +3", {3, 3}},          {"alternating +-", {3, -3}},
+      {"alternating -+", {-3, 3}}};
+  ASSERT_EQ(shapes.size(), expect.size());
+  for (size_t i = 0; i < expect.size(); ++i) {
+    EXPECT_EQ(shapes[i].first, expect[i].first);
+    EXPECT_EQ(shapes[i].second, Eigen::Map<const VecX>(expect[i].second.data(), 2)) << shapes[i].first;
+  }
+  o.directions = 1;  // only the first direction set, also in the extremes; 12 betas: 10 zeros each
+  const auto one = topology_design_shapes(12, o);
+  ASSERT_EQ(one.size(), 5u);  // zero, beta0=-3, beta0=+3, all -3, all +3 (no alternation with one direction)
+  EXPECT_EQ(one[3].second[0], -3);
+  EXPECT_EQ(one[3].second.tail(11).cwiseAbs().maxCoeff(), 0);
+  o.directions = 0;
+  EXPECT_TRUE(topology_design_shapes(2, o).empty());
+}
+
+// The template stage ran its design on the capsule (9 design shapes) and left a mesh whose
+// tets are valid at β = 0 with every node in a tet and per-node fields of one length.
+TEST(TopologyDesign, TemplateCarriesItsDesignReport) {
+  const TemplateVolume& tv = tmpl();
+  const TopologyDesignReport& r = tv.report.topology;
+  std::printf("%s\n", r.describe().c_str());
+  ASSERT_EQ(r.shapes.size(), 9u);
+  EXPECT_EQ(r.min_dihedral_after.size(), 9u);
+  EXPECT_EQ(tv.tet.num_nodes(), r.nodes_before - r.ears_removed);
+  EXPECT_EQ(tv.tet.num_elements(),
+            r.tets_before - r.caps_removed_at_corners - r.caps_removed + r.flips_2_3 - r.flips_3_2 - r.ears_removed);
+  EXPECT_EQ(r.corners_screened, 4);
+  EXPECT_EQ(tet_quality_report(tv.tet).num_inverted, 0);
+  const int N = tv.tet.num_nodes();
+  EXPECT_EQ(tv.node_depth.size(), N);
+  EXPECT_EQ(tv.node_weights.rows(), N);
+  EXPECT_EQ(tv.node_shapedirs[0].rows(), N);
+  EXPECT_EQ(tv.tet_region.size(), tv.tet.num_elements());
+  std::vector<int> uses(size_t(N), 0);
+  for (int t = 0; t < tv.tet.num_elements(); ++t)
+    for (int c = 0; c < 4; ++c) ++uses[size_t(tv.tet.elements(t, c))];
+  EXPECT_EQ(std::count(uses.begin(), uses.end(), 0), 0);
+}
+
+// keep_template_nodes (ear removal at the template stage): a node appended to every per-node
+// field, in no tet, goes; every other node keeps its values and the tets their nodes. A node a
+// tet uses cannot go.
+TEST(TopologyDesign, KeepTemplateNodesDropsANodeFromEveryField) {
+  const TemplateVolume& tv = tmpl();
+  const int N = tv.tet.num_nodes();
+  TemplateVolume big = tv;
+  auto grow = [](auto& m) {
+    m.conservativeResize(m.rows() + 1, Eigen::NoChange);
+    m.row(m.rows() - 1).setConstant(7);
+  };
+  grow(big.tet.nodes), grow(big.node_face_bary), grow(big.node_skeleton_coefficients), grow(big.node_residual),
+      grow(big.node_weights);
+  for (auto& d : big.node_shapedirs) grow(d);
+  auto grow_vec = [](auto& v, auto value) {
+    v.conservativeResize(v.size() + 1);
+    v[v.size() - 1] = value;
+  };
+  grow_vec(big.node_face, 0), grow_vec(big.node_depth, 0.5), grow_vec(big.node_segment, 0),
+      grow_vec(big.node_role, 0), grow_vec(big.outer_nodes, N);
+  if (big.node_posedirs.size() > 0) big.node_posedirs.conservativeResize(3 * (N + 1), Eigen::NoChange);
+  std::vector<int> kept(static_cast<size_t>(N));
+  std::iota(kept.begin(), kept.end(), 0);
+  keep_template_nodes(big, kept);
+  EXPECT_EQ(big.tet.nodes, tv.tet.nodes);
+  EXPECT_EQ(big.tet.elements, tv.tet.elements);
+  EXPECT_EQ(big.outer_nodes, tv.outer_nodes);
+  EXPECT_EQ(big.node_weights, tv.node_weights);
+  EXPECT_EQ(big.node_shapedirs[1], tv.node_shapedirs[1]);
+  EXPECT_EQ(big.node_depth, tv.node_depth);
+  TemplateVolume t2 = tv;
+  std::vector<int> no_first(kept.begin() + 1, kept.end());
+  EXPECT_THROW(keep_template_nodes(t2, no_first), Error);
 }
 
 // The real default body; slow (tens of seconds), run with

@@ -9,6 +9,9 @@
 //   /meta/model_hash       string    body_model_hash() of the source body model
 //   /meta/model_source     string    "procedural" or the model file path
 //   /meta/tool_version     string    "sflsh X.Y.Z"
+//   /meta/topology_hash    string    tet_topology_hash(/tet/elements) (mesh/tet_topology_hash.hpp):
+//                                    the same for every shape of one template; optional
+//                                    (older files have none), checked on reading when present
 //   /skeleton/joints_rest  (24,3)    unposed shaped joint positions
 //   /skeleton/parents      (24,)     parent index, -1 for the root
 //   /skeleton/joint_names  (24,)     strings

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/mesh/geometry_set.hpp"
 #include "sflsh/mesh/tet_mesh.hpp"
 
 namespace sflsh {
@@ -32,6 +33,15 @@ struct BoundaryCapReport {
 /// moved or renumbered. Deterministic (lowest tet index first).
 BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
                                            std::vector<int>* kept = nullptr);
+/// The same for the tets `elements` (#T by 4) judged at every geometry of
+/// `set`: a cap goes if it is inverted or below `floor_deg` at one of them,
+/// or if `bad_elsewhere` (#T flags, optional) flags it (bad at placements
+/// measured outside `set`). Removing a tet makes no other worse anywhere
+/// (see replacement_accepted).
+BoundaryCapReport remove_bad_boundary_caps(Tets& elements, const GeometrySet& set,
+                                           const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept = nullptr,
+                                           const std::vector<char>* bad_elsewhere = nullptr);
 
 /// Removes, repeatedly until none is left, every *ear* of `mesh` below the
 /// floor: a tet three of whose faces are boundary faces around an apex node
@@ -48,6 +58,14 @@ BoundaryCapReport remove_bad_boundary_caps(TetMesh& mesh, const std::vector<char
 /// that stay (their apex is in other tets too, e.g. at a pinched vertex).
 /// Deterministic (lowest tet index first).
 BoundaryCapReport remove_bad_boundary_ears(TetMesh& mesh, const std::vector<char>& on_surface, double floor_deg,
+                                           std::vector<int>* kept_tets = nullptr,
+                                           std::vector<int>* kept_nodes = nullptr);
+/// The same for the tets `elements` judged at every geometry of `set` (an
+/// ear goes if it is inverted or below `floor_deg` at one of them).
+/// `elements` is renumbered to the kept nodes; the geometries are not touched
+/// (compact them with `kept_nodes`).
+BoundaryCapReport remove_bad_boundary_ears(Tets& elements, const GeometrySet& set,
+                                           const std::vector<char>& on_surface, double floor_deg,
                                            std::vector<int>* kept_tets = nullptr,
                                            std::vector<int>* kept_nodes = nullptr);
 

@@ -8,8 +8,13 @@
 //     model, β and every option that changes the avatar (avatar_content_key),
 //     so a rerun skips rows that are done and a crashed run resumes. Rows with
 //     the same key share one file, computed once.
-//   Manifest: one CSV line per row: row,line,name,key,file,status,seconds,
-//     peak_rss_mib,error (write_batch_manifest).
+//   Manifest: one CSV line per row: row,line,name,key,file,status,topology,
+//     seconds,peak_rss_mib,error (write_batch_manifest); topology is the
+//     output's element array hash (mesh/tet_topology_hash.hpp).
+//   One topology: every avatar in an output folder has the same tets (seed
+//     §4); a folder whose files differ, or differ from what the run would
+//     build, is refused (check_batch_topology), and so is a manifest whose
+//     recorded topology is not its file's (verify_batch_manifest).
 //   Slices: a row belongs to shard i/n when row % n == i, so the n shards of
 //     a file cover every row exactly once; --task-index r runs row r alone.
 #include <string>
@@ -67,12 +72,16 @@ struct BatchRecord {
   double seconds = 0;       ///< wall time of this row's work (worker process: its whole run)
   double peak_rss_mib = 0;  ///< peak memory of the process that built it
   std::string error;        ///< the one-line reason when failed; the first row when duplicate
+  /// tet_topology_hash of the output's elements (built and exists rows; "" otherwise).
+  std::string topology;
+  int manifest_line = 0;    ///< 1-based line in the manifest it was read from (read_batch_manifest)
 };
 
 /// The records of the rows of `shapes` in `shard` (all rows when
 /// `task_index` < 0, else that row alone, which must exist): invalid rows
 /// failed, rows whose key an earlier row of the file has are duplicate,
-/// rows whose file is already done exist, the rest pending.
+/// rows whose file is already done exist (with their file's topology), the
+/// rest pending.
 std::vector<BatchRecord> plan_batch(const std::vector<BatchShape>& shapes, const BodyModel& model,
                                     const PrecomputeOptions& options, const std::string& out_dir,
                                     const BatchShard& shard = {}, int task_index = -1);
@@ -84,11 +93,30 @@ std::vector<BatchRecord> plan_batch(const std::vector<BatchShape>& shapes, const
 BatchRecord precompute_batch_row(const BatchRecord& pending, const BatchShape& shape, const TemplateVolume& tv,
                                  const BodyModel& model, const PrecomputeOptions& options);
 
-/// Writes `records` as CSV (header row,line,name,key,file,status,seconds,
-/// peak_rss_mib,error), atomically.
+/// Writes `records` as CSV (header row,line,name,key,file,status,topology,
+/// seconds,peak_rss_mib,error), atomically.
 void write_batch_manifest(const std::vector<BatchRecord>& records, const std::string& path);
-/// Reads a manifest written by write_batch_manifest; throws naming the file and line.
+/// Reads a manifest written by write_batch_manifest (also one from before the
+/// topology column: topology ""); throws naming the file and line.
 std::vector<BatchRecord> read_batch_manifest(const std::string& path);
+
+/// The tet topology of the avatar file `path`: its /meta/topology_hash, or for
+/// files written before that dataset, tet_topology_hash of /tet/elements.
+/// Throws naming the file when it cannot be read.
+std::string avatar_file_topology(const std::string& path);
+
+/// Refuses (throws one line naming both files) an `out_dir` whose
+/// avatar-*.h5 files do not all have the same tet topology, and (naming the
+/// file and `expected_from`) one whose files differ from `expected` (the
+/// topology this run builds; "" = not checked). Files that are not readable
+/// avatars are passed over (a batch rebuilds them). A missing folder passes.
+void check_batch_topology(const std::string& out_dir, const std::string& expected = "",
+                          const std::string& expected_from = "");
+
+/// Refuses (throws one line naming the manifest line, the row and the file) a
+/// manifest with a row whose recorded topology is not that of its file (rows
+/// without a recorded topology or without a file on disk are not checked).
+void verify_batch_manifest(const std::string& path);
 
 /// Counts per status, time, per-shape mean, largest peak memory and a table
 /// of the failed rows (row, line, name, error). `wall_s` is the batch's wall time.

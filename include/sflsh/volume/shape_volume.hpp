@@ -2,11 +2,13 @@
 // The geometric part of the shape stage of `sflsh precompute` (seed §4): the
 // template tet mesh moved to shape β, the spatially varying skin thickness,
 // and the avatar's geometric fields (surface embedding, regions, materials,
-// local frames, capsules).
+// local frames, capsules). It only moves nodes: every shape keeps the
+// template's tets (seed §4: one tetrahedral discretization for all shapes);
+// the topological repairs a shape would need are made once, for the whole
+// shape space, by the template stage (volume/topology_design.hpp).
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/body/body_model.hpp"
 #include "sflsh/mesh/interior_smoothing.hpp"
-#include "sflsh/mesh/tet_flips.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 #include "sflsh/volume/template_volume.hpp"
 #include "sflsh/volume/thickness_map.hpp"
@@ -39,7 +41,7 @@ struct ShapeOptions {
   /// nodes move freely, bone-surface nodes slide across their paths (in the
   /// plane orthogonal to skeleton point -> skin point), skin nodes stay, until
   /// no tet is below smoothing.target_deg or no move helps. passes = 0 skips it
-  /// and also the untangling, cap removal and flips below (the bare placement).
+  /// and also the untangling and skin sliding below (the bare placement).
   InteriorSmoothingOptions smoothing;
   /// If tets stay below quality_floor_deg after that (tets with all four nodes on the
   /// skin, where the shape flattened the skin), a second round also lets the
@@ -52,17 +54,10 @@ struct ShapeOptions {
   /// inverted tets is replaced by its harmonic extension, over a region
   /// growing by two rings per round. 0 skips it.
   int untangle_rounds = 6;
-  /// Remove tets with all four nodes and two faces on the skin that are
-  /// inverted or below the floor (a boundary edge flip where the shape made a
-  /// convex ridge of the skin concave; see mesh/boundary_caps.hpp), before and
-  /// after the optimization.
-  bool remove_bad_caps = true;
-  /// Sweeps of 2-3/3-2 flips on the tets still below smoothing.target_deg
-  /// after the node moves (mesh/tet_flips.hpp), followed by one more round of
-  /// node moves. 0 skips them.
-  int flip_rounds = 4;
-  /// Reach of the skin nodes in that last round of node moves (fraction of
-  /// their shortest edge, from where they are after the flips).
+  /// If tets still stay below quality_floor_deg (mostly ears of the skin: a
+  /// skin node in a single tet, which only moving along the skin can raise),
+  /// a last round lets the skin nodes of the bad tets slide this fraction of
+  /// their shortest edge from where they are. 0 skips it.
   double final_skin_slide_fraction = 1.0;
 };
 
@@ -75,16 +70,10 @@ struct ShapeReport {
   /// Nodes off the skin whose displacement was made harmonic to untangle folds
   /// (summed over the rounds).
   int untangled_nodes = 0;
-  /// Skin cap tets removed (the avatar has that many fewer tets than the template).
-  int caps_removed = 0;
-  /// Skin ears removed with their apex node (the avatar has that many fewer
-  /// tets and nodes than the template; mesh/boundary_caps.hpp).
-  int ears_removed = 0;
-  /// Flips made after the node moves (the tet count changes by one per flip).
-  TetFlipReport flips;
   /// The interior/bone-surface node optimization (quality before/after it),
-  /// and the second round with skin nodes sliding (passes = 0 if not run).
-  InteriorSmoothingReport smoothing, skin_smoothing;
+  /// the second round with skin nodes sliding and the last, wider one
+  /// (passes = 0 if not run).
+  InteriorSmoothingReport smoothing, skin_smoothing, wide_skin_smoothing;
   /// Whether the shaped skin (the body model's surface at these betas)
   /// self-intersects: 1 or 0, tested (CGAL) only when the shaped mesh has an
   /// inverted tet or one below quality_floor_deg; −1 when not tested. A
@@ -102,12 +91,31 @@ struct ShapedVolume {
   Avatar avatar;
   VecX node_depth;       ///< #N depth fraction after the thickness map
   VecX node_thickness_scale;  ///< #N smoothed thickness scale applied
-  /// #N template node of each avatar node (the identity unless ears were
-  /// removed, ShapeReport::ears_removed): per-node template fields follow it.
-  VecXi template_nodes;
   ShapeReport report;
 };
 
+/// The node placement of the shape stage alone (what shape_volume does
+/// before it fills the avatar's fields): #N = the template's nodes.
+struct ShapedNodes {
+  Points nodes;               ///< #N by 3, shaped, unposed (m)
+  VecX node_depth;            ///< #N depth fraction after the thickness map
+  VecX node_thickness_scale;  ///< #N smoothed thickness scale applied
+  Points node_skeleton;       ///< #N by 3 skeleton point of each node's path at β (m)
+  Points v_shaped;            ///< #V by 3 the model's skin at β (m)
+  Points joints;              ///< #J by 3 joints at β (m)
+  /// quality (inverted tets counted, not thrown), relaxation, untangling and
+  /// smoothing figures, seconds; the embedding and self-intersection fields unset.
+  ShapeReport report;
+};
+
+/// Moves the template's nodes to shape `betas` as shape_volume does
+/// (placement along the paths, thickness map, untangling, interior
+/// optimization, skin sliding); the tets are tv.tet.elements throughout.
+/// Unlike shape_volume it does not throw when tets stay inverted (the
+/// template stage measures candidate shapes with it).
+ShapedNodes place_shape_nodes(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
+                              const ThicknessMap& thickness = ThicknessMap::defaults(),
+                              const ShapeOptions& options = {});
 /// Shape stage (geometry) for shape `betas` (missing entries 0). Nodes
 /// follow the correspondence path: x = s(β) + d' (σ(β) - s(β)) + ρ(β), with
 /// s the skeleton point (from the shaped joints), σ the skin point,
@@ -121,9 +129,11 @@ struct ShapedVolume {
 /// where it would flatten tets (ShapeOptions::min_dihedral_deg). Then the
 /// interior nodes and the bone-surface nodes (sliding across their paths) are
 /// moved to raise the smallest dihedral angle (ShapeOptions::smoothing); the
-/// skin nodes stay where the shape puts them. Throws if
-/// tets stay inverted (then the shape itself folds the mesh) or `tv` was
-/// built from another model.
+/// skin nodes stay on the shaped skin (they only slide along it, for tets the
+/// interior moves leave below the floor). The avatar's tets are tv's
+/// (avatar.tet.elements == tv.tet.elements, avatar.tet_region == tv.tet_region)
+/// for every β. Throws if tets stay inverted (then the shape itself folds the
+/// mesh) or `tv` was built from another model.
 ShapedVolume shape_volume(const TemplateVolume& tv, const BodyModel& model, const VecX& betas,
                           const ThicknessMap& thickness = ThicknessMap::defaults(), const ShapeOptions& options = {});
 

@@ -18,7 +18,50 @@
 namespace sflsh {
 
 // 2: bone-surface/interior nodes relocated by sliver repair.
-inline constexpr int kTemplateVolumeFormatVersion = 2;
+// 3: the tets repaired once for the whole shape space (topology design): a
+//    cache of version 2 holds the mesher's tets and is rebuilt, not reused.
+inline constexpr int kTemplateVolumeFormatVersion = 3;
+
+/// The template stage's topology design (volume/topology_design.hpp): the
+/// one connectivity every shape uses is repaired for the corners of the shape
+/// box (skin caps) and at a set of design shapes (every repair).
+struct TopologyDesignOptions {
+  /// Design shapes: β = 0; each of the first `directions` shape directions
+  /// alone at −range and +range; all of them at −range, all at +range; and
+  /// the two alternating corners (+−+−..., −+−+...). The skin caps are also
+  /// screened at all 2^directions corners. directions = 0 skips the design
+  /// (the mesher's tets are kept).
+  int directions = 10;
+  double range = 3.0;
+  /// A tet inverted or below this (deg) at a design shape is repaired (the
+  /// shape stage's quality_floor_deg).
+  double floor_deg = 8.0;
+  /// 2-3/3-2 flips are tried on tets below this (deg) at a design shape (the
+  /// shape stage's smoothing target).
+  double flip_target_deg = 10.0;
+  /// Rounds of (node placement at the design shapes, repairs), until no
+  /// design shape has a tet inverted or below floor_deg or no repair is accepted.
+  int rounds = 3;
+};
+
+/// What the topology design did.
+struct TopologyDesignReport {
+  std::vector<std::string> shapes;  ///< design shape names ("zero", "beta3=-3", "all -3", ...)
+  /// Per design shape: min dihedral (deg) and inverted tets of the node-only
+  /// placement on the mesher's tets (before) and on the repaired tets (after).
+  std::vector<double> min_dihedral_before, min_dihedral_after;
+  std::vector<int> inverted_before, inverted_after;
+  /// Skin caps removed before the rounds because some corner of the shape box
+  /// makes them inverted or flat (the skin's placement is linear in β, so all
+  /// 2^directions corners are screened); corners_screened = 2^directions.
+  int caps_removed_at_corners = 0;
+  long corners_screened = 0;
+  int caps_removed = 0, ears_removed = 0, flips_2_3 = 0, flips_3_2 = 0, flips_2_2 = 0;
+  int rounds = 0;            ///< rounds of repairs made
+  int tets_before = 0, nodes_before = 0;
+  double seconds = 0;
+  std::string describe() const;
+};
 
 struct TemplateOptions {
   /// Depth fraction of the inner (bone) surface along skeleton -> skin
@@ -35,6 +78,8 @@ struct TemplateOptions {
   /// Node relocation of the remaining slivers (bone-surface and interior
   /// nodes only; passes = 0 skips it).
   SliverRepairOptions sliver_repair;
+  /// The repairs of the tets, once for all shapes (seed §4).
+  TopologyDesignOptions topology;
   /// Nodes whose skinning weights on head/hand/foot joints (is_skinned_joint)
   /// sum to at least this are Skinned.
   double skinned_weight_threshold = 0.5;
@@ -59,7 +104,8 @@ struct TemplateOptions {
 struct TemplateReport {
   TetrahedralizeReport mesh;  ///< quality figures are after sliver repair
   SliverRepairReport sliver_repair;
-  double correspondence_s = 0, mesh_s = 0, extension_s = 0, total_s = 0;
+  TopologyDesignReport topology;
+  double correspondence_s = 0, mesh_s = 0, extension_s = 0, topology_s = 0, total_s = 0;
   /// Max distance of outer-boundary nodes to the skin (m) and max distance
   /// of skin vertices to the tet outer boundary (m).
   double outer_node_to_skin = 0, skin_to_outer_boundary = 0;
@@ -109,8 +155,10 @@ struct TemplateVolume {
   TemplateReport report;
 };
 
-/// Runs the template stage on `model` (shows progress). Throws sflsh::Error
-/// if meshing fails or the mesh is invalid (inverted tets).
+/// Runs the template stage on `model` (shows progress): correspondence,
+/// meshing, node paths and fields, then the topology design
+/// (volume/topology_design.hpp), which fixes the tets every shape uses.
+/// Throws sflsh::Error if meshing fails or the mesh is invalid (inverted tets).
 TemplateVolume build_template_volume(const BodyModel& model, const TemplateOptions& options = {});
 
 /// Cache file (HDF5, group /template, written atomically).
