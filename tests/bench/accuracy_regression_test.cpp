@@ -14,7 +14,8 @@
 // carry the figure. Skinning only (u = 0, rel_err 1 everywhere) must exceed
 // the pins of the regions below 0.86: the pins can fail.
 //
-// Measured (2026-11-28, Release, 2 cores; identical in two runs; 27-32 s) with
+// Measured (2026-11-28, Release, 2 cores, on the template whose topology serves every
+// shape: its repairs are designed over 25 shapes) with
 //   build/test_bench --gtest_filter='AccuracyRegression.*'
 // which prints every region's rel_err (the "[ accuracy ]" lines).
 #include <gtest/gtest.h>
@@ -61,10 +62,10 @@ const BenchRow* find_row(const std::vector<BenchRow>& rows, const std::string& m
 TEST(AccuracyRegression, ReducedJumpOnACoarseBodyStaysWithinItsPinnedErrorPerRegion) {
   // rel_err measured (see the header); "overall" is the row's rel_err over every simulated skin vertex.
   const std::map<std::string, double> measured = {
-      {"overall", 0.2688}, {"torso", 0.2885}, {"belly", 0.2183},     {"chest", 0.1813},
-      {"buttocks", 0.2624}, {"thigh", 0.2836}, {"calf", 0.6002},     {"upper_arm", 0.7547},
-      {"forearm", 0.8366}, {"neck", 0.7844},  {"head", 1.5984},      {"hand", 0.9581},
-      {"foot", 1.0895},
+      {"overall", 0.3274}, {"torso", 0.3390}, {"belly", 0.2828},     {"chest", 0.2850},
+      {"buttocks", 0.3401}, {"thigh", 0.3198}, {"calf", 0.6129},     {"upper_arm", 0.7599},
+      {"forearm", 0.8206}, {"neck", 0.7982},  {"head", 1.6328},      {"hand", 0.9470},
+      {"foot", 1.0159},
   };
   // The names whose rel_err in `row` (overall and per region) exceeds its pin.
   auto over_the_pins = [&](const BenchRow& row) {
