@@ -6,19 +6,16 @@
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
-namespace {
 
-TetQuality quality(const Points& x, const TetNodes& t) {
+TetQuality tet_quality_at(const Points& x, const TetNodes& t) {
   return tet_quality(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose(),
                      x.row(t[3]).transpose());
 }
 
-}  // namespace
-
 double worst_dihedral_deg(const Points& x, const std::vector<TetNodes>& tets) {
   double worst = 180;
   for (const TetNodes& t : tets) {
-    const TetQuality q = quality(x, t);
+    const TetQuality q = tet_quality_at(x, t);
     if (!(q.signed_volume > 0)) return -1;
     worst = std::min(worst, q.min_dihedral_deg);
   }
@@ -40,7 +37,7 @@ bool replacement_accepted(const GeometrySet& set, const std::vector<TetNodes>& f
 
 bool orient_at_reference(const GeometrySet& set, std::vector<TetNodes>& tets) {
   for (TetNodes& t : tets) {
-    const double v = quality(set.front(), t).signed_volume;
+    const double v = tet_quality_at(set.front(), t).signed_volume;
     if (!(v != 0)) return false;
     if (v < 0) std::swap(t[2], t[3]);
   }

@@ -20,17 +20,12 @@ Face key(int a, int b, int c) {
   return f;
 }
 
-TetQuality quality(const Points& x, const Tet& t) {
-  return tet_quality(x.row(t[0]).transpose(), x.row(t[1]).transpose(), x.row(t[2]).transpose(),
-                     x.row(t[3]).transpose());
-}
-
 // Orients the candidate tets alike at the reference geometry (all positive if
 // the flip is valid there); false if one is degenerate or they disagree.
 bool orient_alike_at_reference(const GeometrySet& set, std::vector<Tet>& tets) {
   int sign = 0;
   for (Tet& t : tets) {
-    const double v = quality(set.front(), t).signed_volume;
+    const double v = tet_quality_at(set.front(), t).signed_volume;
     const int s = v > 0 ? 1 : (v < 0 ? -1 : 0);
     if (s == 0 || (sign != 0 && s != sign)) return false;
     sign = s;
@@ -48,9 +43,9 @@ bool same_volume(const GeometrySet& set, const std::vector<Tet>& fresh, const st
   for (const Points& x : set) {
     double a = 0, b = 0;
     bool old_valid = true;
-    for (const Tet& t : fresh) a += std::abs(quality(x, t).signed_volume);
+    for (const Tet& t : fresh) a += std::abs(tet_quality_at(x, t).signed_volume);
     for (const Tet& t : old) {
-      const double v = quality(x, t).signed_volume;
+      const double v = tet_quality_at(x, t).signed_volume;
       old_valid = old_valid && v > 0;
       b += v;
     }

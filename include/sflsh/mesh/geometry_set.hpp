@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
 
@@ -16,6 +17,9 @@ namespace sflsh {
 using GeometrySet = std::vector<Points>;
 
 using TetNodes = std::array<int, 4>;
+
+/// Quality of the tet `t` (node indices, in order) at node positions `x` (#N by 3).
+TetQuality tet_quality_at(const Points& x, const TetNodes& t);
 
 /// Smallest dihedral angle (deg) of `tets` at node positions `x` (#N by 3),
 /// or −1 when any of them is not positively oriented (so an inverted tet
