@@ -841,8 +841,7 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
     const Points dent = patch_surface_displacement(a, m.report, k);
     for (int v = 0; v < n; ++v) {
       if (dent.row(v).isZero()) continue;
-      Mat3 A = Mat3::Zero();
-      for (int j = 0; j < a.surface_weights.cols(); ++j) A += a.surface_weights(v, j) * sim.state(k).bones[j].linear();
+      const Mat3 A = skinning_rotation_blend(a.surface_weights.row(v), sim.state(k).bones);
       displacement.row(v0 + v) += dent.row(v);
       positions.row(v0 + v) += (A * dent.row(v).transpose()).transpose();
     }

@@ -280,6 +280,13 @@ Points surface_pose_offsets(const Avatar& a, const std::vector<Isometry>& bones)
   return b;
 }
 
+Mat3 skinning_rotation_blend(const Eigen::Ref<const Eigen::RowVectorXd>& weights, const std::vector<Isometry>& bones) {
+  Mat3 A = Mat3::Zero();
+  for (int j = 0; j < weights.size(); ++j)
+    if (weights[j] != 0.0) A += weights[j] * bones[j].linear();
+  return A;
+}
+
 Points posed_joints(const Avatar& a, const std::vector<Isometry>& bones) {
   return joint_world_positions(bones, a.joints_rest);
 }

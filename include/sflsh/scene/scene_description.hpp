@@ -123,6 +123,7 @@
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/newton_step.hpp"
 
 namespace sflsh {
@@ -264,9 +265,9 @@ struct ContactDescription {
   /// Frictionless: refused with friction > 0; a dynamic object is refused
   /// when the scene is built. Tools keep the per-sample penalty.
   bool patch = false;
-  double patch_radius = 0.04;           ///< m
-  double pressure_stiffness = 1.0e8;    ///< N/m³
-  double patch_spacing = 0.002;         ///< m, face sample spacing
+  double patch_radius = ContactPatchOptions().patch_radius;  ///< m
+  double pressure_stiffness = kDefaultPressureStiffness;      ///< N/m³
+  double patch_spacing = kDefaultContactSpacing;              ///< m, face sample spacing
 };
 
 struct SolverDescription {

@@ -102,6 +102,10 @@ class PosedPoints {
 /// Zero when the asset has no pose blend shapes.
 Points surface_pose_offsets(const Avatar& avatar, const std::vector<Isometry>& bones);
 
+/// Σ_j w_j R_j, the blend of the bones' rotations by one row of skinning
+/// weights: how an unposed offset of a skinned point turns into a world one.
+Mat3 skinning_rotation_blend(const Eigen::Ref<const Eigen::RowVectorXd>& weights, const std::vector<Isometry>& bones);
+
 /// 24 by 3 world joint positions G_j · joints_rest[j] (m): joint_world_positions on the avatar.
 Points posed_joints(const Avatar& avatar, const std::vector<Isometry>& bones);
 

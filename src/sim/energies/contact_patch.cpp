@@ -71,15 +71,6 @@ PatchCache& patch_cache(const StepContext& ctx, const std::string& name) {
 
 const DofLayout& local_layout(const StepContext& ctx) { return ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout; }
 
-/// Σ_j w_j R_j over the non-zero entries of a row of skinning weights.
-template <class Row>
-Mat3 blend_rotation(const Row& w, const std::vector<Isometry>& bones) {
-  Mat3 A = Mat3::Zero();
-  for (int j = 0; j < w.size(); ++j)
-    if (w[j] != 0.0) A += w[j] * bones[j].linear();
-  return A;
-}
-
 /// Adds the generalized force of a world force `f` on an offset d = Σ_j w_j R_j o
 /// (o unposed) to the bones' rotations: ∂d/∂ω_j = −[w_j R_j o]×, so bone j's
 /// ω gains (w_j R_j o) × f (translations do not move an offset).
@@ -130,14 +121,10 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   }
   nodes_ = PosedPoints::at_cubature(a, at_nodes);
   grads_ = fem::tet_gradients(a.tet);
-  tet_volume_.resize(T);
+  tet_volume_ = fem::tet_volumes(a.tet);
   node_mass_ = VecX::Zero(N);
   materials_.reserve(T);
   for (int t = 0; t < T; ++t) {
-    Mat3 D;
-    for (int c = 1; c < 4; ++c)
-      D.col(c - 1) = (a.tet.nodes.row(a.tet.elements(t, c)) - a.tet.nodes.row(a.tet.elements(t, 0))).transpose();
-    tet_volume_[t] = D.determinant() / 6.0;
     const RegionMaterial& m = tet_material(a, t);
     materials_.emplace_back(m, tet_frame(a, t));
     for (int c = 0; c < 4; ++c) node_mass_[a.tet.elements(t, c)] += m.density * tet_volume_[t] / 4.0;
@@ -373,7 +360,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   for (size_t i = 0; i < c.nodes.size(); ++i) {
     const int n = c.nodes[i];
     const double m = node_mass_[n];
-    A[i] = blend_rotation(a.node_weights.row(n), q.bones);
+    A[i] = skinning_rotation_blend(a.node_weights.row(n), q.bones);
     const Vec3 d = A[i] * du.segment<3>(3 * i);
     const Vec3 e = d - c.d_pred[i];
     const Vec3 r = nodes_.world_point(n, q) - c.x_star[i];
@@ -483,7 +470,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   std::vector<std::array<std::pair<int, double>, 4>> couple(nv);
   for (size_t i = 0; i < nv; ++i) {
     const int v = c.vertices[i];
-    Av[i] = blend_rotation(a.surface_weights.row(v), q.bones);
+    Av[i] = skinning_rotation_blend(a.surface_weights.row(v), q.bones);
     Vec3 off = Vec3::Zero();
     const int t = a.surface_tet[v];
     for (int k = 0; k < 4; ++k) {
@@ -720,7 +707,7 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
     const int n = c.nodes[i];
     PatchHistory& h = c.history[n];
     h.du_next = du.segment<3>(3 * i);
-    h.d_next = blend_rotation(avatar_->node_weights.row(n), q.bones) * h.du_next;
+    h.d_next = skinning_rotation_blend(avatar_->node_weights.row(n), q.bones) * h.du_next;
     max_du = std::max(max_du, h.du_next.norm());
     packed.segment<4>(4 * i) << double(n), h.du_next;
   }
