@@ -21,12 +21,12 @@ cd "$(dirname "$0")/.."
 REPO=$(pwd)
 PY=/usr/bin/python3
 BUILD=${SFLSH_BUILD_DIR:-build}
-SFLSH="$REPO/$BUILD/sflsh"
+case $BUILD in /*) BUILD_ABS=$BUILD ;; *) BUILD_ABS="$REPO/$BUILD" ;; esac
+SFLSH="$BUILD_ABS/sflsh"
 SHARED=${SFLSH_SHARED_DIR:-$REPO/../shared}
 MOCAP="$SHARED/data/mocap/cmu"
 
 QUICK=0 OUT="" ONLY="" BUILD_FIRST=1 LIST=0
-ARGS="$*"
 while [ $# -gt 0 ]; do
   case $1 in
     --quick) QUICK=1; shift ;;
@@ -80,7 +80,7 @@ if [ -n "$ONLY" ]; then
 fi
 
 if [ -z "$OUT" ]; then
-  if [ "$QUICK" = 1 ]; then OUT="$BUILD/results-quick"; else OUT=scripts/results; fi
+  if [ "$QUICK" = 1 ]; then OUT="$BUILD_ABS/results-quick"; else OUT=scripts/results; fi
 fi
 mkdir -p "$OUT" || exit 2
 OUT=$(cd "$OUT" && pwd)
@@ -120,6 +120,7 @@ begin() { STEP=$1; T0=$(date -u '+%Y-%m-%d %H:%M UTC'); LOAD0=$(loadavg); }
 run() {
   local log="$WORK/logs/$STEP.log" start=$SECONDS rc
   CMD="$*"
+  CMD=${CMD//"$REPO/"/}   # paths relative to the repository
   echo "== [$STEP] $(date -u +%H:%M:%S) $CMD"
   echo "   (log: $log)"
   if [ -n "${RUN_STDOUT:-}" ]; then "$@" > "$RUN_STDOUT" 2> "$log"; else "$@" > "$log" 2>&1; fi
@@ -180,7 +181,7 @@ for step in $STEPS; do
     stamp "$d/contact_probe.svg" "$OUT/contact_patch_probe.svg" ;;
   hertz)
     tmp="$WORK/hertz.md"; rm -f "$tmp"
-    run env SFLSH_HERTZ_MD="$tmp" "$REPO/$BUILD/test_sim" --gtest_filter=FullFemHertz.DISABLED_ConvergenceTable \
+    run env SFLSH_HERTZ_MD="$tmp" "$BUILD_ABS/test_sim" --gtest_filter=FullFemHertz.DISABLED_ConvergenceTable \
       --gtest_also_run_disabled_tests
     stamp "$tmp" "$OUT/hertz.md" ;;
   stress)
@@ -247,7 +248,7 @@ for step in $STEPS; do
     stamp "$d/batch_resume_check.md" "$OUT/batch_resume_check.md" ;;
   shapes)
     cache=$(mktemp -d)
-    run env SFLSH_CACHE_DIR="$cache" "$PY" scripts/shape_quality_sweep.py --build "$REPO/$BUILD" --models procedural \
+    run env SFLSH_CACHE_DIR="$cache" "$PY" scripts/shape_quality_sweep.py --build "$BUILD_ABS" --models procedural \
       --corners 32 --random 20 --out "$WORK/shape_topology.md"
     rm -rf "$cache"
     stamp "$WORK/shape_topology.md" "$OUT/shape_topology.md" ;;
