@@ -12,11 +12,12 @@ sending a pose to receiving the force computed with it.
 The message format (README "Teleoperation stream";
 include/sflsh/teleop/stream_message.hpp):
   pose      device -> simulator, 88 bytes, struct "<IHHQd3d4dd":
-            magic 0x50544653 ("SFTP"), version 1, type 1, sequence, device time (s),
+            magic 0x50544653 ("SFTP"), version 2, type 1, sequence, device time (s),
             x y z (m), qw qx qy qz, closure (jaw opening angle, rad, 0..pi)
-  feedback  simulator -> device, 72 bytes, struct "<IHHQd3d3d":
-            magic, version 1, type 2, echoed sequence, sim time (s),
-            force x y z (N), torque x y z (N m)
+  feedback  simulator -> device, 80 bytes, struct "<IHHQd3d3dII":
+            magic, version 2, type 2, echoed sequence, sim time (s),
+            force x y z (N), torque x y z (N m), status (0 running, 1 ramping
+            in, 2 ended: zero force), reserved
 
 Abuse options: --drop F skips a fraction F of the samples (the sequence
 number still advances, as with a lossy link); --corrupt F replaces a fraction
@@ -39,10 +40,10 @@ import sys
 import time
 
 MAGIC = 0x50544653
-VERSION = 1
+VERSION = 2
 POSE = struct.Struct("<IHHQd3d4dd")
-FEEDBACK = struct.Struct("<IHHQd3d3d")
-assert POSE.size == 88 and FEEDBACK.size == 72
+FEEDBACK = struct.Struct("<IHHQd3d3dII")
+assert POSE.size == 88 and FEEDBACK.size == 80
 CSV_COLUMNS = ["time", "x", "y", "z", "qw", "qx", "qy", "qz", "closure"]
 
 
@@ -186,7 +187,7 @@ def main():
                 stats["bad_feedback"] += 1
                 continue
             f = FEEDBACK.unpack(data)
-            if f[0] != MAGIC or f[1] != VERSION or f[2] != 2:
+            if f[0] != MAGIC or f[1] != VERSION or f[2] != 2 or f[11] > 2:
                 stats["bad_feedback"] += 1
                 continue
             stats["feedback"] += 1

@@ -157,6 +157,7 @@ void run_scene_live(const RunArgs& a) {
       result.stop_reason = stopped;
     }
   }
+  session.end_feedback();  // from here on, a device gets zero force and status "ended"
   std::cout << status.describe(a.realtime) << "\n";
   if (view) std::cout << view->summary() << "\n";
   for (const SceneToolEvent& e : session.tool_events())

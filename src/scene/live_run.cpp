@@ -134,6 +134,7 @@ LiveRunStatus run_live(SceneSession& s, const LiveRunOptions& opt, const LiveRun
       end_frame();
     }
   }
+  s.end_feedback();
   st.wall_time = wall_seconds() - start;
   st.sim_time = double(st.steps) * s.dt();
   st.rtf = st.wall_time > 0 ? st.sim_time / st.wall_time : 0.0;

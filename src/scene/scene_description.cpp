@@ -321,12 +321,13 @@ ToolDescription parse_tool(const SceneParser& p, const YAML::Node& n, const std:
   if (stream) {
     if (file) p.error(file, k("pose_file"), "give one pose source: 'pose_stream' or 'pose_file', not both");
     const std::string sk = k("pose_stream");
-    p.check_map(stream, sk, {"port", "max_speed"}, "a pose stream");
+    p.check_map(stream, sk, {"port", "max_speed", "ramp_in"}, "a pose stream");
     const double port = p.non_negative(p.required(stream, sk, "port"), sk + ".port");
     if (port != std::floor(port) || port > 65535)
       p.error(stream["port"], sk + ".port", "expected a UDP port number 0..65535 (0: any free port), got ", port);
     t.stream_port = int(port);
     if (const auto v = stream["max_speed"]) t.stream_max_speed = p.positive(v, sk + ".max_speed");
+    if (const auto v = stream["ramp_in"]) t.stream_ramp_in = p.non_negative(v, sk + ".ramp_in");
   } else if (bool(kf) == bool(file)) {
     p.error(n, key, "give exactly one pose source: 'keyframes', 'pose_file' or 'pose_stream'");
   }
@@ -722,7 +723,7 @@ void emit_tool(YAML::Emitter& e, const ToolDescription& t) {
   if (t.stream_port >= 0) {
     e << YAML::Key << "pose_stream" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "port"
       << YAML::Value << t.stream_port << YAML::Key << "max_speed" << YAML::Value << num(t.stream_max_speed)
-      << YAML::EndMap;
+      << YAML::Key << "ramp_in" << YAML::Value << num(t.stream_ramp_in) << YAML::EndMap;
   }
   if (!t.pose_file.empty()) {
     e << YAML::Key << "pose_file" << YAML::Value << t.pose_file;

@@ -27,6 +27,7 @@
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sflsh/teleop/pose_file.hpp"
 #include "sflsh/teleop/pose_recorder.hpp"
+#include "sflsh/teleop/pose_ramp.hpp"
 #include "sflsh/teleop/pose_stream_link.hpp"
 #include "sflsh/teleop/pose_track.hpp"
 
@@ -136,6 +137,8 @@ struct SceneTool {
   std::unique_ptr<teleop::PoseStreamLink> link;  ///< a live stream (pose_stream)
   std::uint64_t link_sequence = 0;               ///< the newest stream sample taken
   bool link_seen = false;
+  /// The live device's take-over of the tool's pose (started by the first live sample).
+  teleop::PoseRamp ramp;
   int model_index = -1;  ///< coupled tools: their rigid body in the model
   /// Gripper jaws: contact shapes turning about the hinge with the closure.
   struct Jaw {
@@ -232,6 +235,10 @@ struct SceneSession::Impl {
   /// Puts the tools at their t = 0 device poses (coupled tools' bodies in `s`)
   /// and starts their recordings.
   void start_tools(State& s);
+  /// A live device takes over tool `t` at time `t0`: from the tool's pose by a
+  /// ramp when it has one (keyframes, pose file), else the tool is placed on
+  /// the device's first pose (a coupled body with it, at rest).
+  void take_over(SceneTool& t, double t0);
   /// Rebuilds the simulator's model from base_model with the stiffness
   /// scales (its elastic and damping terms wrapped), keeping the state.
   void apply_stiffness();
@@ -504,6 +511,22 @@ void SceneSession::Impl::build() {
   for (SceneTool& t : tools) t.grasps_at_start = t.grasps;
 }
 
+void SceneSession::Impl::take_over(SceneTool& t, double t0) {
+  const bool has_pose = !t.desc->keyframes.empty() || !t.desc->pose_file.empty();
+  const Isometry device = sample_pose(t.pushed);
+  if (has_pose) {
+    t.ramp = teleop::PoseRamp(t0, t.desc->stream_ramp_in, t.pose(*sim), device);
+    return;
+  }
+  t.ramp = teleop::PoseRamp(t0, 0.0, device, device);
+  t.device_now = t.pushed;
+  if (t.model_index >= 0) {
+    State s = sim->scene_state();
+    s.bodies[size_t(t.model_index)] = {Configuration{{device}, VecX(0)}, Configuration{{device}, VecX(0)}};
+    sim->set_state(s);
+  }
+}
+
 void SceneSession::Impl::start_tools(State& s) {
   for (SceneTool& t : tools) {
     t.device_now = t.track->at(0.0, t.hold ? PoseInterpolation::kHold : PoseInterpolation::kLinear);
@@ -557,6 +580,11 @@ double SceneSession::seconds() const { return impl_->seconds; }
 long SceneSession::total_steps() const { return impl_->steps; }
 const StepReport& SceneSession::last_report() const { return impl_->report; }
 
+void SceneSession::end_feedback() {
+  for (SceneTool& t : impl_->tools)
+    if (t.link) t.link->end();
+}
+
 void SceneSession::reset() {
   Impl& m = *impl_;
   m.k = 0;
@@ -570,6 +598,7 @@ void SceneSession::reset() {
     t.pushed = PoseSample{};
     t.link_seen = false;
     t.link_sequence = 0;
+    t.ramp = teleop::PoseRamp();
     t.state = SceneToolState{};
     t.recorded = PoseSample{};
     t.recorder.reset();  // drops the rows so far (before start_tools opens the file again)
@@ -621,12 +650,14 @@ const StepReport& SceneSession::advance() {
         tl.live = true;
       }
     }
+    if (tl.live && !tl.ramp.started()) m.take_over(tl, t - h);
     // The device at t (the grasp looks from there) and at t + h (where the
     // step takes the tool). Keyframes and pose files are interpolated at both
     // times; live and recorded devices step from the pose held at t.
     const bool linear = !tl.live && !tl.hold;
     const PoseSample now = linear ? tl.track->at(t - h) : tl.device_now;
-    const PoseSample next = tl.live ? tl.pushed : linear ? tl.track->at(t) : tl.track->at(t, PoseInterpolation::kHold);
+    const PoseSample next = tl.live ? tl.ramp.apply(tl.pushed, t)
+                                    : linear ? tl.track->at(t) : tl.track->at(t, PoseInterpolation::kHold);
     const WorldFrame f = frame_between(sample_pose(now), sample_pose(next), h);
     const bool coupled = tl.model_index >= 0;
     in.frames[coupled ? device_frame_name(tl.desc->name) : tl.desc->name] = f;
@@ -659,7 +690,7 @@ const StepReport& SceneSession::advance() {
       tl.recorded = next;
     }
     tl.device_now = next;
-    tl.state.device = next;
+    tl.state.device = tl.live ? tl.pushed : next;  // the device's own sample (next may be ramped)
   }
   m.report = sim.step(in);
   m.k = k + 1;
@@ -700,7 +731,10 @@ const StepReport& SceneSession::advance() {
     ts.feedback_force *= cd.haptic_gain;
     ts.feedback_torque *= cd.haptic_gain;
     if (ts.feedback_force.norm() > cd.max_force) ts.feedback_force *= cd.max_force / ts.feedback_force.norm();
-    if (tl.link) tl.link->publish(ts.feedback_force, ts.feedback_torque, t);
+    ts.ramping_in = tl.ramp.active(t);
+    if (tl.link)
+      tl.link->publish(ts.feedback_force, ts.feedback_torque, t,
+                       ts.ramping_in ? teleop::FeedbackStatus::kRampIn : teleop::FeedbackStatus::kRunning);
   }
   for (const SceneBody& b : m.bodies)
     if (!sim.state(b.model_index).z.allFinite() || !sim.state(b.model_index).bones[0].matrix().allFinite())

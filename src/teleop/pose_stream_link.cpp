@@ -38,7 +38,7 @@ void PoseStreamLink::run() {
       counters_ = server_.counters();
       f = feedback_;
     }
-    if (got && server_.send_feedback(f.force, f.torque, f.sim_time)) {
+    if (got && server_.send_feedback(f.force, f.torque, f.sim_time, f.status)) {
       std::lock_guard<std::mutex> lock(mutex_);
       ++sent_;
     }
@@ -50,11 +50,24 @@ std::optional<StreamSample> PoseStreamLink::latest() const {
   return latest_;
 }
 
-void PoseStreamLink::publish(const Vec3& force, const Vec3& torque, double sim_time) {
+void PoseStreamLink::publish(const Vec3& force, const Vec3& torque, double sim_time, FeedbackStatus status) {
   std::lock_guard<std::mutex> lock(mutex_);
   feedback_.force = force;
   feedback_.torque = torque;
   feedback_.sim_time = sim_time;
+  feedback_.status = status;
+}
+
+void PoseStreamLink::end() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  feedback_.force.setZero();
+  feedback_.torque.setZero();
+  feedback_.status = FeedbackStatus::kEnded;
+}
+
+bool PoseStreamLink::ended() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return feedback_.status == FeedbackStatus::kEnded;
 }
 
 PoseStreamCounters PoseStreamLink::counters() const {

@@ -114,13 +114,14 @@ void PoseStreamServer::handle(const std::uint8_t* data, std::size_t size, const 
   if (accepted) accepted->push_back(s);
 }
 
-bool PoseStreamServer::send_feedback(const Vec3& force, const Vec3& torque, double sim_time) {
+bool PoseStreamServer::send_feedback(const Vec3& force, const Vec3& torque, double sim_time, FeedbackStatus status) {
   if (!last_good_ || reply_to_.size() != sizeof(sockaddr_in)) return false;
   FeedbackMessage m;
   m.sequence = last_good_->sequence;
   m.sim_time = sim_time;
   m.force = force;
   m.torque = torque;
+  m.status = status;
   const auto bytes = encode_feedback(m);
   const ssize_t n = ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(reply_to_.data()),
                              sizeof(sockaddr_in));

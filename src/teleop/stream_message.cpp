@@ -66,7 +66,8 @@ void write_header(Writer& w, std::uint16_t type) {
 
 // Checks the 8-byte header and the size; on success `r` stands after it.
 template <class M>
-bool check_header(Reader& r, std::size_t size, std::uint16_t want_type, std::size_t want_size, Decoded<M>& out) {
+bool check_header(Reader& r, std::size_t size, std::uint16_t want_type, std::size_t want_size,
+                  std::uint16_t oldest_version, Decoded<M>& out) {
   auto reject = [&](RejectReason why, const std::string& detail) {
     out.reason = why;
     out.detail = detail;
@@ -80,9 +81,12 @@ bool check_header(Reader& r, std::size_t size, std::uint16_t want_type, std::siz
     return reject(RejectReason::kBadMagic, os.str());
   }
   const std::uint16_t version = r.u16();
-  if (version != kStreamVersion)
+  if (version < oldest_version || version > kStreamVersion)
     return reject(RejectReason::kBadVersion,
-                  "version " + std::to_string(version) + ", expected " + std::to_string(kStreamVersion));
+                  "version " + std::to_string(version) + ", expected " +
+                      (oldest_version == kStreamVersion ? std::to_string(kStreamVersion)
+                                                        : std::to_string(oldest_version) + ".." +
+                                                              std::to_string(kStreamVersion)));
   const std::uint16_t type = r.u16();
   if (type != want_type)
     return reject(RejectReason::kWrongType,
@@ -96,12 +100,12 @@ bool check_header(Reader& r, std::size_t size, std::uint16_t want_type, std::siz
 // Checks the framing and, when it is right, reads the body with `read_body(reader, message)`.
 template <class M, class ReadBody>
 Decoded<M> decode_framed(const std::uint8_t* data, std::size_t size, std::uint16_t type, std::size_t want_size,
-                         ReadBody read_body) {
+                         std::uint16_t oldest_version, ReadBody read_body) {
   Decoded<M> out;
   Reader r(data);
-  if (!check_header(r, size, type, want_size, out)) return out;
+  if (!check_header(r, size, type, want_size, oldest_version, out)) return out;
   M m;
-  read_body(r, m);
+  if (!read_body(r, m, out)) return out;
   out.message = m;
   return out;
 }
@@ -148,28 +152,41 @@ std::array<std::uint8_t, kFeedbackMessageSize> encode_feedback(const FeedbackMes
   w.f64(m.sim_time);
   w.vec(m.force);
   w.vec(m.torque);
+  w.u32(static_cast<std::uint32_t>(m.status));
+  w.u32(0);
   return out;
 }
 
 Decoded<PoseMessage> decode_pose(const std::uint8_t* data, std::size_t size) {
-  return decode_framed<PoseMessage>(data, size, kPoseMessageType, kPoseMessageSize, [](Reader& r, PoseMessage& m) {
+  return decode_framed<PoseMessage>(data, size, kPoseMessageType, kPoseMessageSize, kOldestPoseVersion,
+                                    [](Reader& r, PoseMessage& m, Decoded<PoseMessage>&) {
     m.sequence = r.u64();
     m.sample.time = r.f64();
     m.sample.position = r.vec();
     const double w = r.f64(), x = r.f64(), y = r.f64(), z = r.f64();
     m.sample.orientation = Eigen::Quaterniond(w, x, y, z);
     m.sample.closure = r.f64();
+    return true;
   });
 }
 
 Decoded<FeedbackMessage> decode_feedback(const std::uint8_t* data, std::size_t size) {
-  return decode_framed<FeedbackMessage>(data, size, kFeedbackMessageType, kFeedbackMessageSize,
-                                        [](Reader& r, FeedbackMessage& m) {
-                                          m.sequence = r.u64();
-                                          m.sim_time = r.f64();
-                                          m.force = r.vec();
-                                          m.torque = r.vec();
-                                        });
+  return decode_framed<FeedbackMessage>(
+      data, size, kFeedbackMessageType, kFeedbackMessageSize, kStreamVersion,
+      [](Reader& r, FeedbackMessage& m, Decoded<FeedbackMessage>& out) {
+        m.sequence = r.u64();
+        m.sim_time = r.f64();
+        m.force = r.vec();
+        m.torque = r.vec();
+        const std::uint32_t status = r.u32();
+        if (status >= kNumFeedbackStatus) {
+          out.reason = RejectReason::kMalformed;
+          out.detail = "status " + std::to_string(status) + ", expected 0 (running), 1 (ramping in) or 2 (ended)";
+          return false;
+        }
+        m.status = static_cast<FeedbackStatus>(status);
+        return true;
+      });
 }
 
 }  // namespace sflsh::teleop

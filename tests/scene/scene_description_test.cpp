@@ -587,5 +587,25 @@ TEST(SceneDescription, ContactPatchKeysParseWriteBackAndRefuseBadValues) {
   expect_scene_error(body + "contact: {friction: 0, patch: {size: 1}}\n", {"scene.yaml:5:", "contact.patch", "size"});
 }
 
+
+TEST(SceneDescription, PoseStreamRampInParsesWritesBackAndRefusesNegatives) {
+  SceneFolder folder;
+  const std::string head = "bodies:\n  - {name: a, avatar: avatar.h5}\nsolver: {seconds: 1}\ntools:\n";
+  const SceneDescription d = parse_scene_description(head + "  - {name: t, pose_stream: {port: 0}}\n",
+                                                     folder.file("d.yaml"));
+  EXPECT_EQ(d.tools.at(0).stream_ramp_in, 0.5);  // the documented default
+  const SceneDescription s = parse_scene_description(
+      head + "  - {name: t, pose_stream: {port: 0, max_speed: 3, ramp_in: 0.25}}\n", folder.file("s.yaml"));
+  EXPECT_EQ(s.tools.at(0).stream_ramp_in, 0.25);
+  EXPECT_EQ(s.tools.at(0).stream_max_speed, 3.0);
+  const SceneDescription off = parse_scene_description(
+      head + "  - {name: t, pose_stream: {port: 0, ramp_in: 0}}\n", folder.file("o.yaml"));
+  EXPECT_EQ(off.tools.at(0).stream_ramp_in, 0.0);  // 0: the device takes over at once
+  write_scene_description(s, folder.file("again.yaml"));
+  EXPECT_EQ(read_scene_description(folder.file("again.yaml")).tools.at(0).stream_ramp_in, 0.25);
+  expect_scene_error(head + "  - {name: t, pose_stream: {port: 0, ramp_in: -0.5}}\n",
+                     {"tools[0].pose_stream.ramp_in", "-0.5"});
+}
+
 }  // namespace
 }  // namespace sflsh

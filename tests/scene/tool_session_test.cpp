@@ -293,3 +293,82 @@ tools:
   EXPECT_LT((r.objects[0].poses.back().translation() - (tool + Vec3(0, -0.01, 0.004))).norm(), 1e-12);
   EXPECT_GT(peak, 0.05);
 }
+
+namespace {
+
+/// A coupled probe at rest in free space above the box (no contact), its
+/// device's first live pose 1 cm to the side; `ramp` is pose_stream.ramp_in.
+std::string take_over_yaml(const std::string& ramp) {
+  return std::string(R"(
+solver: {dt: 1/250, seconds: 2, gravity: [0, 0, 0]}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: probe
+    shape: {type: sphere, radius: 0.005}
+    keyframes: [{time: 0, position: [0.0, 0.08, 0.0]}]
+    pose_stream: {port: 0, ramp_in: )") + ramp + R"(}
+    coupling: {stiffness: 2.0e4, mass: 0.1, max_force: 1000}
+)";
+}
+
+}  // namespace
+
+TEST_F(ToolSession, ALiveDeviceTakesOverAToolWithoutAKick) {
+  teleop::PoseSample device;
+  device.position = Vec3(0.01, 0.08, 0.0);  // 1 cm from the tool's keyframe pose
+  // Without a ramp the coupling jumps: the spring stretched by up to 1 cm
+  // plus the damper of a device that seems to move 1 cm in one step (54 N here).
+  SceneSession abrupt(read_scene_description(write_scene(take_over_yaml("0"))), quiet());
+  abrupt.set_device_pose(0, device);
+  abrupt.advance();
+  EXPECT_GT(abrupt.tool_state(0).feedback_force.norm(), 30.0);
+  // With the default ramp the tool is brought over in 0.5 s: in free space the
+  // coupling only accelerates the 0.1 kg tool along a smoothstep of 1 cm
+  // (peak 6·0.01/0.5² = 0.24 m/s², i.e. 0.024 N).
+  SceneDescription sc = read_scene_description(write_scene(take_over_yaml("0.5")));
+  SceneSession s(sc, quiet());
+  s.set_device_pose(0, device);
+  double peak = 0;
+  bool ramping_seen = false;
+  for (int k = 0; k < 150; ++k) {  // 0.6 s
+    s.advance();
+    peak = std::max(peak, s.tool_state(0).feedback_force.norm());
+    if (k == 0) ramping_seen = s.tool_state(0).ramping_in;
+    EXPECT_EQ(s.tool_state(0).device.position, device.position);  // the device's own sample
+  }
+  EXPECT_TRUE(ramping_seen);
+  EXPECT_FALSE(s.tool_state(0).ramping_in);
+  EXPECT_LT(peak, 0.1);
+  for (int k = 0; k < 100; ++k) s.advance();
+  EXPECT_LT((s.tool_state(0).pose.translation() - device.position).norm(), 1e-4);
+}
+
+TEST_F(ToolSession, AfterTheRunEndsTheDeviceGetsZeroForceAndStatusEnded) {
+  SceneSession s(read_scene_description(write_scene(take_over_yaml("0.5"))), quiet());
+  const int port = s.stream_port(0);
+  ASSERT_GT(port, 0);
+  Device dev(port);
+  std::uint64_t seq = 1;
+  dev.pose(seq++, 0.01, Vec3(0.01, 0.08, 0.0));
+  ASSERT_TRUE(step_until_device_at(s, Vec3(0.01, 0.08, 0.0)));
+  for (int k = 0; k < 5; ++k) s.advance();
+  dev.pose(seq++, 0.02, Vec3(0.01, 0.08, 0.0));
+  std::optional<teleop::FeedbackMessage> fb;
+  for (int tries = 0; tries < 100 && !(fb && fb->sequence == seq - 1); ++tries)
+    if (auto got = dev.feedback(0.01)) fb = got;
+  ASSERT_TRUE(fb.has_value());
+  EXPECT_EQ(fb->status, teleop::FeedbackStatus::kRampIn);  // 6+ steps of a 0.5 s ramp
+  const double end_time = s.time();
+  s.end_feedback();
+  dev.pose(seq++, 0.03, Vec3(0.02, 0.07, 0.0));
+  fb.reset();
+  for (int tries = 0; tries < 100 && !(fb && fb->sequence == seq - 1); ++tries)
+    if (auto got = dev.feedback(0.01)) fb = got;
+  ASSERT_TRUE(fb.has_value());
+  EXPECT_EQ(fb->sequence, seq - 1);
+  EXPECT_EQ(fb->status, teleop::FeedbackStatus::kEnded);
+  EXPECT_EQ(fb->force, Vec3::Zero());
+  EXPECT_EQ(fb->torque, Vec3::Zero());
+  EXPECT_DOUBLE_EQ(fb->sim_time, end_time);
+}

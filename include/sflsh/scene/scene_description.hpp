@@ -235,6 +235,9 @@ struct ToolDescription {
   /// −1: none); keyframes, if given, hold the tool until the first sample.
   int stream_port = -1;
   double stream_max_speed = 20.0;          ///< m/s: samples implying a faster jump are rejected
+  /// s: a live device takes over a tool that has a pose (keyframes, pose file)
+  /// by fading out their offset over this time (teleop/pose_ramp.hpp); 0: at once.
+  double stream_ramp_in = 0.5;
   bool coupled = false;                    ///< virtual coupling (else kinematic)
   ToolCouplingDescription coupling;
   /// Two-jaw gripper (optional): the hinge (a point and an axis in the tool

@@ -80,6 +80,7 @@ struct SceneToolState {
   int anchors = 0;           ///< flesh points anchored now
   double max_stretch = 0;    ///< m, the largest anchor stretch |x_p − a_p|
   bool live = false;         ///< the pose comes from a stream or set_device_pose()
+  bool ramping_in = false;   ///< the tool is still being brought to the device (pose_stream.ramp_in)
 };
 
 /// A grasp or release (AMBF Alg. 3).
@@ -159,6 +160,10 @@ class SceneSession {
   /// follows pushed poses from now on (its keyframes/file are no longer read).
   /// Throws on a non-finite pose or a zero quaternion.
   void set_device_pose(int tool, const teleop::PoseSample& sample);
+  /// The run is over: every live stream answers later poses with zero force
+  /// and torque, status "ended" and the final sim_time (the device must not
+  /// be left rendering the last force). advance() resumes the feedback.
+  void end_feedback();
   /// The UDP port of a tool's pose stream (0 when it has none or streams are closed).
   int stream_port(int tool) const;
   /// Closes the recording (record_dir) and renames its files into place;

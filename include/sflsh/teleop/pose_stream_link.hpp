@@ -30,8 +30,14 @@ class PoseStreamLink {
   /// clock since it started), or nothing before the first.
   std::optional<StreamSample> latest() const;
   /// The force (N) and torque (N·m, world) on the tool at simulation time
-  /// `sim_time` (s): sent in reply to every accepted sample from now on.
-  void publish(const Vec3& force, const Vec3& torque, double sim_time);
+  /// `sim_time` (s), with the simulation's status: sent in reply to every
+  /// accepted sample from now on (after end(), the simulation runs again).
+  void publish(const Vec3& force, const Vec3& torque, double sim_time,
+               FeedbackStatus status = FeedbackStatus::kRunning);
+  /// The simulation stopped: every later pose is answered with zero force and
+  /// torque, status kEnded and the last published sim_time.
+  void end();
+  bool ended() const;
   /// Copies of the server's counters and the feedback messages sent.
   PoseStreamCounters counters() const;
   long feedback_sent() const;

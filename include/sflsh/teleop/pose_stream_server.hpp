@@ -57,9 +57,11 @@ class PoseStreamServer {
 
   /// Sends a feedback message echoing the last accepted sequence number to
   /// the address the last accepted sample came from. Force in N, torque in
-  /// N·m (world frame), sim_time in s. Returns false (sends nothing) before
-  /// the first accepted sample or when the socket buffer is full.
-  bool send_feedback(const Vec3& force, const Vec3& torque, double sim_time);
+  /// N·m (world frame), sim_time in s, and the simulation's status. Returns
+  /// false (sends nothing) before the first accepted sample or when the
+  /// socket buffer is full.
+  bool send_feedback(const Vec3& force, const Vec3& torque, double sim_time,
+                     FeedbackStatus status = FeedbackStatus::kRunning);
 
   /// Blocks until a datagram is waiting or `timeout` seconds pass (≥ 0);
   /// returns whether one is waiting. Lets a thread answer at the device rate.
