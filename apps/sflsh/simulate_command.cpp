@@ -21,6 +21,7 @@
 #include "sflsh/scene/result_export.hpp"
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_reference_run.hpp"
 #include "sflsh/scene/scene_run.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 
@@ -36,6 +37,7 @@ struct SimulateArgs {
   int newton_iters = 1, render_frames = 6;
   int iterations_after_damping = NewtonOptions{}.iterations_after_damping;
   std::string nonlinearity_tolerance = "auto";
+  std::string solver = "reduced";  // scene files: reduced | full (the full-FEM reference)
   long inject_nan_at_step = 0;  // test only (hidden option)
   bool line_search = false, use_file_betas = false, start_at_rest = false,
        mean_dilatation = SimulatorOptions().mean_dilatation;
@@ -80,7 +82,13 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   {
     const InterruptScope interrupt_scope;
     try {
-      r = run_scene(scene, o, &stats);
+      if (a.solver == "full") {
+        SceneReferenceOptions ro;
+        ro.cache_dir = o.cache_dir;
+        r = run_scene_reference(scene, ro, &stats);
+      } else {
+        r = run_scene(scene, o, &stats);
+      }
     } catch (SimulationStopped& e) {
       write_simulation_result(e.partial, out.out);  // the numerical guard: the frames made, marked incomplete
       fail(e.what(), "; wrote the ", e.partial.num_frames, " frames before it to ", out.out, " (marked incomplete)");
@@ -287,6 +295,11 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();
   // Test only, hidden from --help: drives the run into the numerical guard.
+  cmd->add_option("--solver", a->solver,
+                  "Scene files: 'reduced' (the avatar's subspace, default) or 'full' (the full-FEM reference: every "
+                  "tet node a DoF, bones prescribed; seconds per step)")
+      ->check(CLI::IsMember({"reduced", "full"}))
+      ->capture_default_str();
   cmd->add_option("--inject-nan-at-step", a->inject_nan_at_step,
                   "TEST ONLY: a NaN motion target at step N (the run must stop there, result marked incomplete)")
       ->group("");
@@ -298,6 +311,8 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
                 "); set it in the scene");
       run_scene_file(*a, cmd->count("--out") > 0);
     } else {
+      require(a->solver == "reduced", "simulate: --solver full runs scene files (sflsh simulate scene.yaml --solver "
+              "full); for a motion, sflsh bench compares the solvers");
       run_simulate(*a);
     }
   });

@@ -1,0 +1,154 @@
+#include "sflsh/scene/scene_reference_run.hpp"
+
+#include <iostream>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/core/interrupt.hpp"
+#include "sflsh/core/progress.hpp"
+#include "sflsh/scene/rigid_object.hpp"
+#include "sflsh/scene/scene_session.hpp"
+#include "sflsh/sim/full_fem.hpp"
+
+namespace sflsh {
+namespace {
+
+const std::string& scene_name(const SceneDescription& sc) {
+  static const std::string unnamed = "scene";
+  return sc.path.empty() ? unnamed : sc.path;
+}
+
+/// Whether contact between the body and `object` is on (contact.pairs).
+bool collides(const ContactDescription& c, const std::string& body, const std::string& object) {
+  if (c.all_pairs) return true;
+  for (const auto& [a, b] : c.pairs)
+    if ((a == body && b == object) || (a == object && b == body)) return true;
+  return false;
+}
+
+/// The scene as the reference runs it: refusals thrown, dynamic bones made
+/// kinematic and friction dropped (each with a warning).
+SceneDescription reference_scene(const SceneDescription& sc) {
+  const std::string& where = scene_name(sc);
+  require(sc.bodies.size() == 1, where, ": --solver full runs one body; the scene has ", sc.bodies.size(),
+          " (body-body contact has no full-FEM reference yet)");
+  for (const RigidObjectDescription& o : sc.objects)
+    require(o.kind != ObjectKind::Dynamic, where, ": objects '", o.name,
+            "' is dynamic; --solver full takes static and kinematic objects only");
+  for (const ToolDescription& t : sc.tools) {
+    require(!t.coupled, where, ": tools '", t.name, "' has a coupling; --solver full takes kinematic tools only");
+    require(t.stream_port < 0, where, ": tools '", t.name, "' reads a live stream; --solver full runs offline");
+    require(t.jaws.empty() && t.sensors.empty(), where, ": tools '", t.name,
+            "' has jaws or a grasp; --solver full has no anchors");
+  }
+  SceneDescription out = sc;
+  if (out.bodies[0].bones_dynamic) {
+    std::cerr << "warning: " << where << ": bodies '" << out.bodies[0].name
+              << "': --solver full prescribes the bones from the motion (bones: dynamic runs as kinematic)\n";
+    out.bodies[0].bones_dynamic = false;
+  }
+  if (out.contact.friction > 0 && (!out.objects.empty() || !out.tools.empty()))
+    std::cerr << "warning: " << where << ": --solver full is frictionless (contact.friction "
+              << out.contact.friction << " is dropped)\n";
+  return out;
+}
+
+}  // namespace
+
+SimulationResult run_scene_reference(const SceneDescription& scene, const SceneReferenceOptions& opt,
+                                     SceneContactStats* stats) {
+  const SceneDescription sc = reference_scene(scene);
+  SceneSessionOptions so;
+  so.progress = false;
+  so.cache_dir = opt.cache_dir;
+  // The session supplies the inputs (bones, object and tool poses) and the result's layout.
+  SceneSession session(sc, so);
+  const Simulator& sim = session.simulator();
+  const int body = session.body_model_index(0);
+  const std::string& body_name = session.body_name(0);
+  FullFemOptions fo;
+  fo.h = session.dt();
+  fo.gravity = sc.solver.gravity;
+  fo.max_iterations = opt.max_iterations;
+  FullFem fem(sim.model().bodies()[size_t(body)].avatar, fo);
+  fem.reset(sim.state(body).bones);
+
+  // Obstacles: the result header's objects (objects, then tools with a shape), those in contact with the body.
+  SimulationResult r = session.result_header();
+  std::vector<int> obstacle_object;  // index into r.objects per obstacle
+  auto add = [&](const std::string& name, const ShapeDescription& shape, ObjectKind kind) {
+    if (!collides(sc.contact, body_name, name)) return;
+    RigidObjectDescription d;
+    d.name = name;
+    d.shape = shape;
+    d.kind = kind;
+    FullFemObstacle ob{name, make_rigid_object(d, opt.cache_dir).field, sc.contact.pressure_stiffness,
+                       sc.contact.patch_spacing};
+    fem.add_obstacle(std::move(ob));
+    for (size_t i = 0; i < r.objects.size(); ++i)
+      if (r.objects[i].name == name) obstacle_object.push_back(int(i));
+    require(obstacle_object.size() == size_t(fem.num_obstacles()), name, ": not in the result's objects");
+  };
+  for (const RigidObjectDescription& o : sc.objects) add(o.name, o.shape, o.kind);
+  for (const ToolDescription& t : sc.tools)
+    if (t.has_shape) add(t.name, t.shape, ObjectKind::Kinematic);
+
+  SceneContactStats st;
+  for (int i = 0; i < fem.num_obstacles(); ++i)
+    st.pairs.push_back({"contact:" + r.objects[size_t(obstacle_object[size_t(i)])].name, body_name});
+  auto record = [&](double ms) {
+    session.record_frame(r, ms);
+    r.frame_positions.back() = fem.posed_surface();
+    r.frame_displacement.back() = fem.soft_displacement();
+    r.frame_reduced.back().setZero();  // the reference has no reduced coordinates
+  };
+  record(0.0);
+  const long steps = session.total_steps();
+  const double frame_dt = 1.0 / sc.output.fps;
+  double next_frame = frame_dt, ms_since_frame = 0;
+  int steps_since_frame = 0, not_converged = 0;
+  Progress progress("full-FEM reference of " + r.motion, steps);
+  for (long k = 0; k < steps; ++k) {
+    if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
+    session.advance();
+    const std::vector<Isometry> all = session.object_poses();
+    std::vector<Isometry> poses;
+    for (int i : obstacle_object) poses.push_back(all.at(size_t(i)));
+    const FullFemReport rep = fem.step(sim.state(body).bones, poses);
+    const double t = (k + 1) * session.dt();
+    if (!rep.converged) ++not_converged;
+    for (size_t i = 0; i < rep.contacts.size(); ++i) {
+      SceneContactStats::Pair& p = st.pairs[i];
+      const FullFemContact& c = rep.contacts[i];
+      p.last_force = c.force;
+      p.max_force = std::max(p.max_force, c.force.norm());
+      p.max_penetration = std::max(p.max_penetration, c.max_penetration);
+      if (c.active_samples > 0) ++p.active_steps;
+    }
+    StepReport sr;  // Newton to convergence: each step counts as accepted (non-converged ones are warned about)
+    sr.accepted = 1;
+    sr.iterations = rep.iterations;
+    sr.energy_after = rep.energy;
+    sr.grad_norm_before = rep.grad_norm_initial;
+    sr.grad_norm_after = rep.grad_norm;
+    sr.ms_total = rep.ms_total;
+    sr.ms_solve = rep.ms_factorize;
+    r.add_step(t, sr);
+    ms_since_frame += rep.ms_total;
+    ++steps_since_frame;
+    if (t + 1e-9 >= next_frame) {
+      record(ms_since_frame / steps_since_frame);
+      next_frame += frame_dt;
+      ms_since_frame = 0;
+      steps_since_frame = 0;
+    }
+    if (opt.progress) progress.update(k + 1);
+  }
+  if (opt.progress) progress.finish();
+  if (not_converged > 0)
+    std::cerr << "warning: " << scene_name(sc) << ": the full-FEM Newton solve stopped at " << opt.max_iterations
+              << " iterations before converging in " << not_converged << " of " << steps << " steps\n";
+  if (stats) *stats = std::move(st);
+  return r;
+}
+
+}  // namespace sflsh

@@ -1,0 +1,108 @@
+// `simulate scene.yaml --solver full`: the full-FEM reference driven by the
+// scene session's inputs, on the small box avatar (6 cm, top at y = 0.03 m).
+#include "sflsh/scene/scene_reference_run.hpp"
+
+#include <gtest/gtest.h>
+
+#include "scene/box_avatar_fixture.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "test_support.hpp"
+
+using namespace sflsh;
+
+namespace {
+
+using SceneReference = test::BoxAvatarScene;
+
+/// A 1 cm ball lowered from 1.5 cm above the top to 5 mm into it by 0.2 s, then held;
+/// `as` is "objects" (a kinematic object) or "tools" (a kinematic tool).
+std::string ball_scene(const std::string& as) {
+  const std::string ball = as == "objects" ? R"(objects:
+  - name: ball
+    shape: {type: sphere, radius: 0.01}
+    kind: kinematic
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.045, 0.0]}
+      - {time: 0.2, position: [0.0, 0.035, 0.0]}
+)"
+                                           : R"(tools:
+  - name: ball
+    shape: {type: sphere, radius: 0.01}
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.045, 0.0]}
+      - {time: 0.2, position: [0.0, 0.035, 0.0]}
+)";
+  return R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
+contact: {friction: 0}
+output: {fps: 20}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+)" + ball;
+}
+
+SceneReferenceOptions quiet() {
+  SceneReferenceOptions o;
+  o.progress = false;
+  return o;
+}
+
+/// The lowest skin point's depth below the top (m) in the last frame, within 5 mm of the axis.
+double dent(const SimulationResult& r) {
+  double lowest = 0.03;
+  const Points& x = r.frame_positions.back();
+  for (int v = 0; v < x.rows(); ++v)
+    if (std::hypot(x(v, 0), x(v, 2)) < 0.005 && x(v, 1) > 0.02) lowest = std::min(lowest, x(v, 1));
+  return 0.03 - lowest;
+}
+
+}  // namespace
+
+TEST_F(SceneReference, TheFullFemDentsUnderAKinematicBallAndPushesItUp) {
+  const SceneDescription sc = read_scene_description(write_scene(ball_scene("objects")));
+  SceneContactStats st;
+  const SimulationResult full = run_scene_reference(sc, quiet(), &st);
+  ASSERT_EQ(full.num_frames, 7);  // t = 0, 0.05, ..., 0.3
+  ASSERT_EQ(st.pairs.size(), 1u);
+  EXPECT_EQ(st.pairs[0].term, "contact:ball");
+  EXPECT_EQ(st.pairs[0].body, "base");
+  // The ball is 5 mm into the undeformed top: the flesh gives way under it
+  // (a dent of millimetres), so the penalty's own penetration is smaller than
+  // 5 mm, and the obstacle presses the body down (the force on the body).
+  const double d = dent(full);
+  EXPECT_GT(d, 2e-3) << "dent " << d;
+  EXPECT_LT(d, 5.5e-3) << "dent " << d;
+  EXPECT_LT(st.pairs[0].max_penetration, 5e-3 - 0.5 * d);
+  EXPECT_LT(st.pairs[0].last_force.y(), -0.05) << st.pairs[0].last_force.transpose();
+  // Mostly vertical (the 1 cm cells' facets under the ball are not symmetric about its axis).
+  EXPECT_LT(std::hypot(st.pairs[0].last_force.x(), st.pairs[0].last_force.z()), 0.2 * -st.pairs[0].last_force.y());
+  // The ball's frames follow its keyframes (held at y = 0.035 after 0.2 s).
+  ASSERT_EQ(full.objects.size(), 1u);
+  EXPECT_NEAR(full.objects[0].poses.back().translation().y(), 0.035, 1e-12);
+}
+
+TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject) {
+  // Two paths to the same obstacle pose (object keyframes, tool track): any
+  // mix-up of poses or fields in either one shows.
+  SceneContactStats a, b;
+  const SimulationResult ra = run_scene_reference(read_scene_description(write_scene(ball_scene("objects"))), quiet(), &a);
+  const SimulationResult rb = run_scene_reference(read_scene_description(write_scene(ball_scene("tools"))), quiet(), &b);
+  ASSERT_EQ(ra.num_frames, rb.num_frames);
+  EXPECT_EQ(ra.frame_positions.back(), rb.frame_positions.back());
+  EXPECT_EQ(a.pairs.at(0).last_force, b.pairs.at(0).last_force);
+  EXPECT_GT(a.pairs.at(0).max_force, 0.05);
+}
+
+TEST_F(SceneReference, ScenesItCannotRunAreRefusedNamingTheItem) {
+  const std::string head = "solver: {dt: 1/100, seconds: 0.1}\nbodies:\n  - {name: base, avatar: box.h5}\n";
+  auto refused = [&](const std::string& text, std::initializer_list<std::string> fragments) {
+    const SceneDescription sc = read_scene_description(write_scene(text));
+    test::expect_error([&] { run_scene_reference(sc, quiet()); }, fragments);
+  };
+  refused(head + "  - {name: other, avatar: box.h5, placement: {offset: [0.2, 0, 0]}}\n", {"scene.yaml", "one body", "has 2"});
+  refused(head + "objects:\n  - {name: rock, shape: {type: sphere, radius: 0.01}, kind: dynamic, density: 1000, "
+                 "position: [0, 0.1, 0]}\n",
+          {"scene.yaml", "objects 'rock'", "dynamic"});
+  refused(head + "tools:\n  - name: probe\n    shape: {type: sphere, radius: 0.005}\n"
+                 "    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    coupling: {stiffness: 2000}\n",
+          {"scene.yaml", "tools 'probe'", "coupling"});
+}
