@@ -48,8 +48,8 @@ echo "== simulate builtin:jump for 3 s"
 
 echo
 echo "== a scene with contact: a ball thrown at the belly (apps/scenes/ball_at_belly.yaml)"
-cp apps/scenes/ball_at_belly.yaml "$OUT/"   # its avatar is the avatar.h5 next to it
-"$SFLSH" simulate "$OUT/ball_at_belly.yaml" --out "$OUT/ball_at_belly.h5" --export "$OUT/ball_at_belly.glb" \
+# avatar: default in the scene: the built-in body, precomputed on first use and cached
+"$SFLSH" simulate apps/scenes/ball_at_belly.yaml --out "$OUT/ball_at_belly.h5" --export "$OUT/ball_at_belly.glb" \
   --render "$OUT/ball_at_belly.png"
 
 echo

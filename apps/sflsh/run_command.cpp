@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "command.hpp"
+#include "scene_avatars.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/io/atomic_output.hpp"
@@ -110,6 +111,7 @@ void run_scene_live(const RunArgs& a) {
   so.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
   so.record_dir = a.record;
   so.replay_dir = a.replay;
+  resolve_default_avatars(scene, so.cache_dir);
   SceneSession session(scene, so);
 
   SimulationResult result = session.result_header();

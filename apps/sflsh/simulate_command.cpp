@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "command.hpp"
+#include "scene_avatars.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
@@ -77,6 +78,7 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   if (!out.export_path.empty()) io::check_output_file(out.export_path, a.exp.empty() ? "output.export" : "--export");
   SceneRunOptions o;
   o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
+  resolve_default_avatars(scene, o.cache_dir);
   SceneContactStats stats;
   SimulationResult r;
   {

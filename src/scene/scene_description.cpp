@@ -161,11 +161,25 @@ class SceneParser {
 // --- sections -----------------------------------------------------------------
 
 BodyDescription parse_body(const SceneParser& p, const YAML::Node& n, const std::string& key) {
-  p.check_map(n, key, {"name", "avatar", "motion", "placement", "bones", "material", "velocity"}, "a body");
+  p.check_map(n, key, {"name", "avatar", "betas", "motion", "placement", "bones", "material", "velocity"}, "a body");
   BodyDescription b;
   b.name = p.text(p.required(n, key, "name"), SceneParser::child_key(key, "name"));
-  b.avatar = p.existing_file(p.required(n, key, "avatar"), SceneParser::child_key(key, "avatar"), "avatar file",
-                             " (make it with `sflsh precompute --out FILE`)");
+  const YAML::Node av = p.required(n, key, "avatar");
+  if (av.IsScalar() && av.Scalar() == kDefaultAvatar) {
+    b.avatar = kDefaultAvatar;  // the built-in body, built on first use (precompute/cached_avatar.hpp)
+    b.default_avatar = true;
+  } else {
+    b.avatar = p.existing_file(av, SceneParser::child_key(key, "avatar"), "avatar file",
+                               " (make it with `sflsh precompute --out FILE`, or write avatar: default)");
+  }
+  if (const auto v = n["betas"]) {
+    const std::string k = SceneParser::child_key(key, "betas");
+    if (!b.default_avatar) p.error(v, k, "betas apply to avatar: default only (an avatar file has its shape)");
+    if (!v.IsSequence() || v.size() == 0 || v.size() > kMaxDefaultAvatarBetas)
+      p.error(v, k, "expected a list of 1 to ", kMaxDefaultAvatarBetas, " numbers");
+    const std::vector<double> betas = p.numbers(v, k, v.size());
+    b.betas = Eigen::Map<const VecX>(betas.data(), Eigen::Index(betas.size()));
+  }
   if (const auto m = n["motion"]) {
     const std::string k = SceneParser::child_key(key, "motion");
     b.motion = p.text(m, k);
@@ -822,8 +836,14 @@ std::string scene_description_yaml(const SceneDescription& scene) {
 
   e << YAML::Key << "bodies" << YAML::Value << YAML::BeginSeq;
   for (const auto& b : scene.bodies) {
-    e << YAML::BeginMap << YAML::Key << "name" << YAML::Value << b.name << YAML::Key << "avatar" << YAML::Value << b.avatar
-      << YAML::Key << "motion" << YAML::Value << b.motion << YAML::Key << "placement" << YAML::Value << YAML::BeginMap
+    e << YAML::BeginMap << YAML::Key << "name" << YAML::Value << b.name << YAML::Key << "avatar" << YAML::Value
+      << (b.default_avatar ? std::string(kDefaultAvatar) : b.avatar);
+    if (b.betas.size() > 0) {
+      e << YAML::Key << "betas" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (Eigen::Index i = 0; i < b.betas.size(); ++i) e << num(b.betas[i]);
+      e << YAML::EndSeq;
+    }
+    e << YAML::Key << "motion" << YAML::Value << b.motion << YAML::Key << "placement" << YAML::Value << YAML::BeginMap
       << YAML::Key << "offset" << YAML::Value;
     emit(e, b.offset);
     e << YAML::Key << "heading_deg" << YAML::Value << num(b.heading_deg) << YAML::EndMap << YAML::Key << "bones" << YAML::Value

@@ -262,6 +262,9 @@ void SceneSession::Impl::build() {
     const std::string key = d.avatar + "\n" + d.material;
     auto it = avatars.find(key);
     if (it == avatars.end()) {
+      require(!d.default_avatar || d.avatar != kDefaultAvatar, sc.path, ": bodies '", d.name,
+              "': avatar: default is not resolved (the sflsh commands build it; a program sets the body's "
+              "avatar to cached_avatar(...).path, sflsh/precompute/cached_avatar.hpp)");
       auto a = std::make_shared<Avatar>(read_avatar(d.avatar));
       if (!d.material.empty()) apply_material_file(d.material, a->materials);
       it = avatars.emplace(key, std::move(a)).first;

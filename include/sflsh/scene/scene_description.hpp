@@ -44,8 +44,11 @@
 //                               # or a list of name pairs: [[alice, floor], [alice, bob]]
 //   bodies:                     # required, at least one
 //     - name: alice             # required; names are unique across bodies and objects
-//       avatar: avatar.h5       # required; relative to this file's folder
-//                               # (make it with `sflsh precompute --out avatar.h5`)
+//       avatar: default         # required: `default` (the built-in body, precomputed on
+//                               # first use and cached: minutes once, then instant), or an
+//                               # avatar file relative to this file's folder
+//                               # (make one with `sflsh precompute --out avatar.h5`)
+//       betas: [1.5, -1]        # avatar: default only: its shape (up to 10 numbers); default 0
 //       motion: builtin:walk    # none | builtin:NAME | a motion file (relative to this
 //                               # file's folder: .npz, .bvh, .fbx, ...); default none
 //       placement:              # where the motion is played in the world
@@ -129,9 +132,18 @@
 namespace sflsh {
 
 /// One avatar in the scene.
+/// `avatar: default`: the built-in body, precomputed on first use and cached
+/// (precompute/cached_avatar.hpp; the sflsh commands resolve it), at shape `betas`.
+constexpr const char* kDefaultAvatar = "default";
+constexpr long kMaxDefaultAvatarBetas = 10;  ///< the built-in body's shape directions
+
 struct BodyDescription {
   std::string name;
-  std::string avatar;              ///< avatar file (absolute after reading)
+  /// Avatar file (absolute after reading), or kDefaultAvatar until it is
+  /// resolved to the cached avatar's path.
+  std::string avatar;
+  bool default_avatar = false;     ///< avatar: default (the built-in body)
+  VecX betas;                      ///< avatar: default's shape (empty: β = 0)
   std::string motion = "none";     ///< "none", "builtin:NAME" or a file (absolute after reading)
   Vec3 offset = Vec3::Zero();      ///< placement: m, world offset
   double heading_deg = 0;          ///< placement: rotation about +Y, degrees
