@@ -508,6 +508,11 @@ TEST(SceneDescription, NonlinearityToleranceIsAutoOrANumber) {
   const SceneDescription n =
       parse_scene_description(body + "solver: {seconds: 1, nonlinearity_tolerance: 0.125}\n", folder.file("n.yaml"));
   EXPECT_EQ(n.solver.nonlinearity_tolerance, 0.125);
+  // 0 is the documented "off" (no iteration added for nonlinearity), not an error.
+  const SceneDescription off =
+      parse_scene_description(body + "solver: {seconds: 1, nonlinearity_tolerance: 0}\n", folder.file("o.yaml"));
+  ASSERT_TRUE(off.solver.nonlinearity_tolerance.has_value());
+  EXPECT_EQ(*off.solver.nonlinearity_tolerance, 0.0);
   write_scene_description(a, folder.file("auto.yaml"));
   std::ifstream f(folder.file("auto.yaml"));
   const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());

@@ -275,3 +275,25 @@ TEST(AnchorTerm, ReportsPerAnchorForcesAndIsInactiveWithoutAnchors) {
 }
 
 }  // namespace
+
+TEST(AnchorTerm, MaxStretchIsTheLargestAnchorsNotTheLastOnes) {
+  // Two anchors: vertex 3 pulled 3 mm along +y, vertex 5 pulled 1 mm along +x
+  // (vertex 5's frame comes last): max_stretch 3 mm, the total force the sum.
+  const Avatar a = flesh_box();
+  const double k = 1.0e3;
+  const AnchorTerm term("jaw", PosedPoints::at_surface(a), false, {k, 0.0});
+  std::mt19937 rng(5);
+  Rig rig = make_rig(a, true, false, rng);
+  rig.q[0] = rig.q_prev[0];
+  WorldFrame jaw;
+  jaw.pose.translation() = Vec3(0.01, 0.02, 0.03);
+  const Vec3 x3 = term.points().world_point(3, rig.q[0]), x5 = term.points().world_point(5, rig.q[0]);
+  add_anchor_frames("jaw", jaw,
+                    {{3, jaw.pose.inverse() * (x3 + Vec3(0, 0.003, 0))}, {5, jaw.pose.inverse() * (x5 + Vec3(0.001, 0, 0))}},
+                    false, rig.frames);
+  StepContext ctx = rig.context();
+  auto cache = begin_term_step(term, ctx);
+  const std::vector<TermQuantity> rep = term.report(ctx, rig.q[0]);
+  EXPECT_NEAR(quantity(rep, "max_stretch")[0], 0.003, 1e-12);
+  EXPECT_LT((quantity(rep, "force") - Vec3(k * 0.001, k * 0.003, 0)).norm(), 1e-9);
+}

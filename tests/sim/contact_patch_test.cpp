@@ -171,10 +171,10 @@ Points node_displacement(const Avatar& a, const VecX& z, const StepReport* rep) 
   return u;
 }
 
-std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iterations) {
+std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iterations, bool gravity = false) {
   ModelOptions mo;
   mo.h = 1.0 / 60.0;
-  mo.gravity = Vec3::Zero();
+  mo.gravity = gravity ? Vec3(0, -9.81, 0) : Vec3::Zero();
   mo.newton.iterations = iterations;
   mo.newton.line_search = iterations > 1;
   mo.newton.gradient_tolerance = iterations > 1 ? 1e-11 : 0.0;
@@ -183,7 +183,7 @@ std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iter
   ModelBuilder mb(mo);
   const int body = mb.add_body({"slab", std::make_shared<const Avatar>(a), false});
   SoftTissueOptions so;
-  so.gravity = false;
+  so.gravity = gravity;
   so.mean_dilatation = false;  // every tet's own volume change, as the patch integrates it
   add_soft_tissue_terms(mb, body, so);
   ContactPatchOptions co;
@@ -226,6 +226,67 @@ TEST(ContactPatch, CoveringTheWholeBodyTheStepIsTheFullSpaceStep) {
   ASSERT_GT(peak, 5e-4);  // a dent of a fraction of the 3 mm
   EXPECT_LT(worst, 1e-6 * peak) << "peak " << peak;
   EXPECT_GT(worst_subspace, 0.1 * peak) << "the coarse subspace alone should not make the dent";
+}
+
+TEST(ContactPatch, UnderGravityTheWholeBodyPatchIsStillTheFullSpaceStep) {
+  // As above with gravity (the patch nodes carry their weight, m g·δu, in the
+  // condensed energy): the slab sags and is dented, and the patch step is the
+  // full-space one.
+  const Avatar nodal = slab(0), coarse = slab(4);
+  Simulator full(pressed_model(nodal, false, 60, true)), reduced(pressed_model(coarse, true, 1, true));
+  StepInputs in;
+  in.bodies.resize(1);
+  in.bodies[0].bones = identity_bones();
+  double peak = 0, worst = 0;
+  for (int i = 1; i <= 3; ++i) {
+    in.frames["ball"].pose.translation() = Vec3(0.003, 0.03 + 0.012 - 0.0005 * i, -0.002);
+    in.frames["ball"].linear_velocity = Vec3(0, -0.0005 * 60, 0);
+    full.step(in);
+    const StepReport rr = reduced.step(in);
+    const Points uf = node_displacement(nodal, full.state().z, nullptr);
+    const Points ur = node_displacement(coarse, reduced.state().z, &rr);
+    peak = std::max(peak, uf.cwiseAbs().maxCoeff());
+    worst = std::max(worst, (ur - uf).cwiseAbs().maxCoeff());
+  }
+  ASSERT_GT(peak, 1e-4);
+  EXPECT_LT(worst, 1e-6 * peak) << "peak " << peak;
+}
+
+TEST(ContactPatch, ThePatchIsTheSimulatedNodesWithinItsRadiusOfTheNearSkin) {
+  // A 1.2 cm ball 1 mm into the slab's top, body and ball at rest: the near
+  // skin is the vertices within the margin of the ball (φ < margin), and the
+  // patch every Simulated node within patch_radius of one of them (counted
+  // here by brute force).
+  const Avatar a = slab(4);
+  const double R = 0.012;
+  const Vec3 centre(0.003, 0.03 + R - 0.001, -0.002);
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = centre;
+  for (double radius : {0.006, 0.011}) {
+    ContactPatchOptions o;
+    o.patch_radius = radius;
+    o.max_patch_nodes = 100000;
+    const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(R), Isometry::Identity(), false, o);
+    StepContext ctx = context(a, &frames, false);
+    const auto cache = begin_term_step(term, ctx);
+    const auto r = term.report(ctx, ctx.q_prev);
+    std::vector<Vec3> near;
+    for (int v = 0; v < a.surface_rest.rows(); ++v) {
+      const Vec3 x = a.surface_rest.row(v).transpose();
+      if ((x - centre).norm() - R < o.margin) near.push_back(x);
+    }
+    ASSERT_FALSE(near.empty());
+    int expected = 0;
+    for (int n = 0; n < a.tet.num_nodes(); ++n) {
+      if (a.node_role[n] != int(NodeRole::Simulated)) continue;
+      const Vec3 y = a.tet.nodes.row(n).transpose();
+      bool within = false;
+      for (const Vec3& x : near) within = within || (y - x).norm() <= radius;
+      expected += within;
+    }
+    ASSERT_GT(expected, 0);
+    EXPECT_EQ(quantity(r, "patch_nodes"), expected) << "radius " << radius;
+  }
 }
 
 TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFiniteDifferences) {

@@ -360,6 +360,47 @@ TEST(SdfContact, BroadPhaseKeepsEveryPenetratingSampleAndNothingFar) {
   EXPECT_THROW(begin_term_step(term, ctx), Error);
 }
 
+TEST(SdfContact, BroadPhaseLooksAheadByTheSkinsAndTheObjectsMotion) {
+  // The reach of the broad phase (sdf_contact.hpp, SdfContactOptions::margin):
+  // margin + twice a sample's displacement over the last step + the object's
+  // motion over the step, h (|v| + |ω| extent) (extent 1 m for a plane). A
+  // floor 4 cm below the box's lowest sample at t, margin 1 cm:
+  const Avatar a = box();
+  auto plane = std::make_shared<geometry::PlaneSdf>(Vec3::UnitY(), 0.0);
+  SdfContactOptions o;
+  o.cluster_size = 0.03;
+  const SdfContactTerm term("floor", PosedPoints::at_surface(a), plane, Isometry::Identity(), false, o);
+  Configuration q;
+  q.bones.assign(24, Isometry::Identity());
+  q.z = VecX::Zero(a.num_reduced());
+  double bottom = 1e9;
+  for (int p = 0; p < term.samples().size(); ++p) bottom = std::min(bottom, term.samples().world_point(p, q).y());
+  std::map<std::string, WorldFrame> frames;
+  frames["floor"].pose.translation() = Vec3(0, bottom - 0.04, 0);
+  auto lowest_is_candidate = [&](std::vector<Bound>& bodies) {
+    StepContext ctx = bind_bodies(bodies, &frames);
+    const auto cache = begin_term_step(term, ctx);
+    const std::vector<int>& cand = term.candidates(ctx);
+    int lowest = 0;
+    for (int p = 0; p < term.samples().size(); ++p)
+      if (term.samples().world_point(p, q).y() < term.samples().world_point(lowest, q).y()) lowest = p;
+    return std::find(cand.begin(), cand.end(), lowest) != cand.end();
+  };
+  // At rest and a still floor: 4 cm is beyond the 1 cm margin.
+  std::vector<Bound> rest{{&a, body_layout(a, false), q, q, q}};
+  EXPECT_FALSE(lowest_is_candidate(rest));
+  // The box fell 2 cm over the last step: 1 cm + 2 × 2 cm reaches the floor.
+  Configuration up = q;
+  for (Isometry& G : up.bones) G.translation().y() += 0.02;
+  std::vector<Bound> falling{{&a, body_layout(a, false), q, q, up}};
+  EXPECT_TRUE(lowest_is_candidate(falling));
+  // The floor turns at 3 rad/s: h · 3 rad/s · 1 m = 5 cm of reach.
+  frames["floor"].angular_velocity = Vec3(3.0, 0, 0);
+  EXPECT_TRUE(lowest_is_candidate(rest));
+  frames["floor"].angular_velocity = Vec3(1.0, 0, 0);  // 1.7 cm: 2.7 cm in all, short of 4 cm
+  EXPECT_FALSE(lowest_is_candidate(rest));
+}
+
 TEST(SdfContact, SampleSpacingKeepsOneVertexPerCell) {
   const Avatar a = box();
   const PosedPoints all = skin_contact_samples(a, 0.0);
@@ -372,6 +413,50 @@ TEST(SdfContact, SampleSpacingKeepsOneVertexPerCell) {
     const Vec3 x = sparse.unposed().row(p).transpose() / 0.08;
     EXPECT_TRUE(cells.insert({long(std::floor(x.x())), long(std::floor(x.y())), long(std::floor(x.z()))}).second);
   }
+  // Each kept sample is, of the cell's vertices, the one nearest the cell's centre.
+  for (int p = 0; p < sparse.size(); ++p) {
+    const Vec3 x = sparse.unposed().row(p).transpose();
+    const Vec3 cell = (x / 0.08).array().floor();
+    const Vec3 centre = (cell.array() + 0.5).matrix() * 0.08;
+    for (int v = 0; v < all.size(); ++v) {
+      const Vec3 y = all.unposed().row(v).transpose();
+      if (Vec3((y / 0.08).array().floor()) != cell) continue;
+      EXPECT_LE((x - centre).norm(), (y - centre).norm() + 1e-15) << "sample " << p << " vs vertex " << v;
+    }
+  }
+}
+
+TEST(SdfContact, FrictionIsCarriedByAKinematicObjectsRotation) {
+  // A floor turning at 2 rad/s about a vertical axis 1 m from the box (the
+  // floor frame's origin at x = −1 m): the point a sample touched at t is
+  // carried h ω × r ≈ 3.3 cm along −z (≫ the static slip h · 1 mm/s), so every
+  // touching sample slides and friction drags the body along −z with μ λ each
+  // (λ = k · 1 mm of penetration at t).
+  const Avatar a = box();
+  auto plane = std::make_shared<geometry::PlaneSdf>(Vec3::UnitY(), 0.0);
+  SdfContactOptions o;
+  o.friction = 0.5;
+  const SdfContactTerm term("floor", PosedPoints::at_surface(a), plane, Isometry::Identity(), false, o);
+  Configuration q;
+  q.bones.assign(24, Isometry::Identity());
+  q.z = VecX::Zero(a.num_reduced());
+  double bottom = 1e9;
+  for (int p = 0; p < term.samples().size(); ++p) bottom = std::min(bottom, term.samples().world_point(p, q).y());
+  std::map<std::string, WorldFrame> frames;
+  frames["floor"].pose.translation() = Vec3(-1.0, bottom + 0.001, 0);
+  frames["floor"].angular_velocity = Vec3(0, 2.0, 0);
+  std::vector<Bound> bodies{{&a, body_layout(a, false), q, q, q}};
+  StepContext ctx = bind_bodies(bodies, &frames);
+  const auto cache = begin_term_step(term, ctx);
+  int touching = 0;
+  for (int p = 0; p < term.samples().size(); ++p) touching += term.samples().world_point(p, q).y() < bottom + 1e-9;
+  ASSERT_GT(touching, 0);
+  const auto rep = term.report(ctx, q);
+  ASSERT_EQ(rep[1].name, "friction_force");
+  const Vec3 f(rep[1].value);
+  const double expected = o.friction * o.stiffness * 0.001 * touching;
+  EXPECT_NEAR(-f.z(), expected, 2e-3 * expected) << f.transpose();
+  EXPECT_LT(std::abs(f.x()) + std::abs(f.y()), 1e-3 * expected) << f.transpose();
 }
 
 TEST(SdfContact, TruncatedSampleRowsKeepTheStrongestHandlesAndTheRowSum) {
@@ -482,6 +567,37 @@ TEST(CapsuleContact, NoEnergyAtAGapAndHalfKDepthSquaredInOverlap) {
     EXPECT_NEAR(d.E, 0.5 * k * depth * depth, 1e-12) << "shift " << shift;
     if (depth == 0.0) EXPECT_EQ(d.grad.norm(), 0.0) << "shift " << shift;
   }
+}
+
+TEST(CapsuleContact, AFastApproachIsCaughtByTheBroadPhaseAndTheForcePushesTheBodiesApart) {
+  // Parallel capsules (radius 3 cm, 6 cm long: bounding spheres of 6 cm) with
+  // body b at +x. At t − h the axes were 20 cm apart, at t 15 cm (b moved 5 cm
+  // in a step), and the step ends at 5.5 cm: 5 mm of overlap. The broad phase
+  // looks 2 cm + twice the last step's motion ahead (12 cm): the pair is near
+  // at t although its bounding spheres are 3 cm apart, so the overlap counts:
+  // E = ½ k (5 mm)², and the force on a is k · 5 mm along −x (away from b).
+  const Avatar a = box(), b = box();
+  const double k = 1.0e4;
+  const CapsuleContactTerm term(a, &b, {k, 2});
+  auto at = [](double x) {
+    Configuration q;
+    q.bones.assign(24, Isometry(Eigen::Translation3d(x, 0, 0)));
+    q.z = VecX::Zero(0);
+    return q;
+  };
+  const Configuration qa = at(0.0);
+  std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa},
+                            {&b, body_layout(b, true), at(0.055), at(0.15), at(0.20)}};
+  for (Bound& bd : bodies) bd.layout.num_reduced = 0;
+  bodies[1].layout.base = bodies[0].layout.size();
+  StepContext ctx = bind_bodies(bodies, nullptr);
+  const auto cache = begin_term_step(term, ctx);
+  ASSERT_TRUE(term.active(ctx));
+  const Derivatives d = analytic(term, ctx, bodies);
+  EXPECT_NEAR(d.E, 0.5 * k * 0.005 * 0.005, 1e-12);
+  const auto rep = term.report(ctx, bodies[0].q);
+  ASSERT_EQ(rep[0].name, "force");
+  EXPECT_LT((Vec3(rep[0].value) - Vec3(-k * 0.005, 0, 0)).norm(), 1e-9) << Vec3(rep[0].value).transpose();
 }
 
 TEST(CapsuleContact, SelfContactSkipsAdjacentBonesAndPairsTouchingAtRest) {

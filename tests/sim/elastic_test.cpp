@@ -7,6 +7,9 @@
 #include "finite_difference.hpp"
 #include "sflsh/sim/energies/damping.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/compression_guard.hpp"
+#include "sflsh/sim/linearized_stiffness.hpp"
+#include "sflsh/sim/material.hpp"
 #include "synthetic_avatar.hpp"
 
 namespace sflsh {
@@ -130,6 +133,38 @@ Avatar damping_slab() {
   o.nx = 1, o.ny = 2, o.nz = 1;
   o.handles = 4;
   return test::make_synthetic_avatar(o);
+}
+
+TEST(Elastic, MeanDilatationGivesTheAveragedBulkShareBackBeyondTheCompressionOnset) {
+  // W = identity and z_n = a·y_n: ∇u = a e_yᵀ in every tet, a = (0, −0.12, 0):
+  // J = 0.88, past the guard's onset 0.92. A uniform strain has the same
+  // averaged and per-tet volume change, so ½ zᵀKz is the same with and without
+  // mean dilatation (LinearizedStiffness.HomogeneousStrainKeepsItsEnergy), and
+  // the energies differ by the compression guard alone: on each sample,
+  // ½ (1 − α) κ (0.92 − J)² (α = kPerTetVolumeShare, the share the averaged form
+  // keeps per tet; compression_guard.hpp), times its cubature weight.
+  test::SyntheticAvatarOptions o;
+  o.handles = 0;
+  const Avatar a = test::make_synthetic_avatar(o);
+  const Vec3 dir(0.0, -0.12, 0.0);
+  Configuration q;
+  q.bones = std::vector<Isometry>(24, Isometry::Identity());
+  q.z = VecX::Zero(a.num_reduced());
+  for (int n = 0; n < a.tet.num_nodes(); ++n)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
+      q.z.segment<3>(3 * it.col()) = a.tet.nodes(n, 1) * dir;
+  const ElasticTerm mean(a, false, true, true), plain(a, false, true, false);
+  const StepContext ctx = z_only_context(a);
+  const double J = 0.88;
+  double expected = 0;
+  for (int k = 0; k < a.elastic.size(); ++k) {
+    const int t = a.elastic.elements[k];
+    const double kappa = MaterialPoint(tet_material(a, t), tet_frame(a, t)).kappa;
+    expected += a.elastic.weights[k] * 0.5 * (1.0 - kPerTetVolumeShare) * kappa * (0.92 - J) * (0.92 - J);
+  }
+  ASSERT_GT(expected, 0);
+  const double diff = mean.evaluate(ctx, q, nullptr, nullptr) - plain.evaluate(ctx, q, nullptr, nullptr);
+  EXPECT_NEAR(diff, expected, 1e-6 * expected);
 }
 
 TEST(Damping, MatchesFiniteDifferencesAndVanishesAtRestVelocity) {

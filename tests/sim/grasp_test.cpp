@@ -254,3 +254,21 @@ TEST(Grasp, ADynamicToolPullingAFreeBodyConservesMomentum) {
 }
 
 }  // namespace
+
+TEST(Grasp, TheThresholdIsExclusiveAndAFaceHitByTwoSensorsIsListedOnce) {
+  const Avatar a = grasp_box();
+  const Points skin = PosedPoints::at_surface(a).world(Configuration{identity_bones(), VecX::Zero(a.num_reduced())});
+  GraspOptions g = jaw_sensors();  // threshold 0.3 rad: grasp while the closure is below it
+  GraspController at(g);
+  EXPECT_FALSE(at.update(0.0, jaw_pose(0), 0.3, skin, a.surface_faces));  // exactly at the threshold: open
+  EXPECT_TRUE(at.anchors().empty());
+  EXPECT_TRUE(at.update(0.1, jaw_pose(0), std::nextafter(0.3, 0.0), skin, a.surface_faces));
+  // Two sensors 0.1 mm apart hit the same face: one face, its three vertices once.
+  g.sensors.push_back({Vec3(-0.0001, 0.0, 0.0), Vec3(0, 0, 1), 0.01});
+  GraspController twin(g);
+  ASSERT_TRUE(twin.update(0.0, jaw_pose(0), 0.0, skin, a.surface_faces));
+  ASSERT_EQ(twin.log().size(), 1u);
+  EXPECT_EQ(twin.log()[0].faces.size(), 1u);
+  EXPECT_EQ(twin.log()[0].points.size(), 3u);
+  EXPECT_EQ(twin.anchors().size(), 3u);
+}

@@ -74,4 +74,29 @@ TEST(RealtimeLoop, AheadOfTheClockRunsNoSubstepAndRejectsBadOptions) {
   EXPECT_THROW(RealtimeLoop({0.01, 0}), Error);
 }
 
+TEST(RealtimeLoop, AStalledFrameDropsItsLagOnceAndFastFramesAfterItKeepTheClock) {
+  // δt = 10 ms, N_max = 3. A 100 ms stall: the next frame runs 3 substeps and
+  // drops the other 70 ms (not caught up later); frames after it run just what
+  // the clock asks, counted from the dropped time.
+  double now = 0;
+  RealtimeLoop loop({0.01, 3}, [&] { return now; });
+  now = 0.1;
+  const RealtimeFrame stalled = loop.frame([](double) {});
+  EXPECT_EQ(stalled.substeps, 3);
+  EXPECT_TRUE(stalled.behind);
+  EXPECT_NEAR(stalled.dropped, 0.07, 1e-12);  // lag 100 ms − 3 × 10 ms run
+  EXPECT_NEAR(loop.dropped(), 0.07, 1e-12);
+  EXPECT_NEAR(loop.time_to_next(), 0.0, 1e-12);  // sim 30 ms + dropped 70 ms = the wall clock
+  now = 0.105;
+  EXPECT_NEAR(loop.time_to_next(), -0.005, 1e-12);
+  const RealtimeFrame next = loop.frame([](double) {});
+  EXPECT_EQ(next.substeps, 1);  // 5 ms of lag since the stall: one substep, not the dropped 70 ms again
+  EXPECT_FALSE(next.behind);
+  EXPECT_NEAR(loop.time_to_next(), 0.005, 1e-12);  // sim 40 ms + 70 ms dropped, 5 ms ahead of 105 ms
+  now = 0.12;
+  EXPECT_EQ(loop.frame([](double) {}).substeps, 1);
+  EXPECT_NEAR(loop.sim_time(), 0.05, 1e-12);
+  EXPECT_EQ(loop.frames_behind(), 1);
+}
+
 }  // namespace

@@ -144,3 +144,29 @@ TEST(VirtualCoupling, RejectsBadOptionsAndAMissingDeviceFrame) {
   r.frames.clear();
   test::expect_error([&] { term.begin_step(r.context()); }, {"coupling:probe", "probe/device"});
 }
+
+TEST(VirtualCoupling, TheRotationalDamperSeesTheDeviceTurning) {
+  // The device turns at ω_d = 2 rad/s about z; the tool turned 0.01 rad about z
+  // over the step. The damper's residual is e = φ − h ω_d = (0.01 − 2 h) ẑ: it
+  // resists the tool turning relative to the device (a device turning with the
+  // tool leaves no damping), energy ½ (c_r/h) e², torque −(c_r/h) e (φ small
+  // and along z: J_l⁻¹(φ)ᵀ e = e).
+  VirtualCouplingOptions o{3000.0, 40.0, 7.0, 0.3};
+  VirtualCouplingTerm term("probe", o);
+  WorldFrame dev;
+  dev.pose = pose(Vec3(0, 0, 0.2), Vec3(0.1, 1.0, 0.2));
+  dev.angular_velocity = Vec3(0, 0, 2.0);
+  const Isometry tool = pose(Vec3(0, 0, 0.2), Vec3(0.1, 1.0, 0.2));
+  const Isometry tool_prev = pose(Vec3(0, 0, 0.19), Vec3(0.1, 1.0, 0.2));
+  Rig r = make_rig(term, tool, tool_prev, dev);
+  const double e = 0.01 - 2.0 * kH;
+  const double expected = 0.5 * (0.3 / kH) * e * e;  // translation and spring terms are zero here
+  EXPECT_NEAR(term.evaluate(r.context(), r.q, nullptr, nullptr), expected, 1e-9 * expected);
+  const auto rep = term.report(r.context(), r.q);
+  ASSERT_EQ(rep[1].name, "torque");
+  EXPECT_NEAR(rep[1].value[2], -(0.3 / kH) * e, 1e-9);
+  // The device turning exactly with the tool (ω_d h = 0.01): no damping torque.
+  dev.angular_velocity = Vec3(0, 0, 0.01 / kH);
+  Rig same = make_rig(term, tool, tool_prev, dev);
+  EXPECT_NEAR(term.report(same.context(), same.q)[1].value[2], 0.0, 1e-9);
+}

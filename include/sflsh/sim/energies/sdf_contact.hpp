@@ -55,7 +55,10 @@ namespace sflsh {
 struct SdfContactOptions {
   double stiffness = 2.0e4;  ///< k, N/m per sample
   /// Candidate margin (m): a sample enters the step's contact set when φ at
-  /// time t is below margin + twice its displacement over the last step.
+  /// time t is below margin + twice its displacement over the last step + the
+  /// object's motion over the step, h (|v| + |ω| extent) for a kinematic object
+  /// (extent: half its bounds' diagonal, 1 m when unbounded), twice its last
+  /// step's for a dynamic one.
   double margin = 0.01;
   /// Broad-phase slack (m) added to every cluster's radius for linear blend
   /// skinning and soft displacement away from the dominant bone's rigid motion.
