@@ -12,7 +12,6 @@
 #include <memory>
 
 #include "command.hpp"
-#include "scene_avatars.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/io/atomic_output.hpp"
@@ -22,6 +21,7 @@
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_session.hpp"
+#include "sflsh/scene_assets/scene_assets.hpp"
 #include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/viewer/live_viewer.hpp"
 
@@ -96,7 +96,6 @@ class ToolLog {
 
 void run_scene_live(const RunArgs& a) {
   SceneDescription scene = read_scene_description(a.scene);
-  validate_scene_files(scene);
   require(a.seconds >= 0 && std::isfinite(a.seconds), "run: --seconds ", a.seconds, ": expected >= 0 (0 = the scene's)");
   require(a.max_substeps >= 1, "run: --max-substeps ", a.max_substeps, ": expected >= 1");
   if (!a.out.empty()) io::check_output_file(a.out, "--out");
@@ -108,10 +107,9 @@ void run_scene_live(const RunArgs& a) {
   require(a.replay.empty() || std::filesystem::is_directory(a.replay), "run: --replay ", a.replay,
           ": not a folder (give the --record folder of a run)");
   SceneSessionOptions so;
-  so.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
   so.record_dir = a.record;
   so.replay_dir = a.replay;
-  resolve_default_avatars(scene, so.cache_dir);
+  prepare_scene_assets(scene, a.cache_dir.empty() ? default_cache_dir() : a.cache_dir);
   SceneSession session(scene, so);
 
   SimulationResult result = session.result_header();

@@ -7,7 +7,6 @@
 #include <limits>
 
 #include "command.hpp"
-#include "scene_avatars.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/precompute.hpp"
 #include "sflsh/core/error.hpp"
@@ -24,6 +23,7 @@
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_reference_run.hpp"
 #include "sflsh/scene/scene_run.hpp"
+#include "sflsh/scene_assets/scene_assets.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 
 namespace sflsh::cli {
@@ -67,7 +67,6 @@ void check_tracking(const SimulationResult& r, const SimulateArgs& a) {
 /// `sflsh simulate scene.yaml`: the scene's outputs, overridden by --out/--export/--render when given.
 void run_scene_file(const SimulateArgs& a, bool out_given) {
   SceneDescription scene = read_scene_description(a.scene);
-  validate_scene_files(scene);
   if (out_given) scene.output.out = a.out;
   if (!a.exp.empty()) scene.output.export_path = a.exp;
   if (!a.render.empty()) scene.output.render = a.render;
@@ -77,8 +76,7 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   if (!out.render.empty()) io::check_output_file(out.render, a.render.empty() ? "output.render" : "--render");
   if (!out.export_path.empty()) io::check_output_file(out.export_path, a.exp.empty() ? "output.export" : "--export");
   SceneRunOptions o;
-  o.cache_dir = a.cache_dir.empty() ? default_cache_dir() : a.cache_dir;
-  resolve_default_avatars(scene, o.cache_dir);
+  prepare_scene_assets(scene, a.cache_dir.empty() ? default_cache_dir() : a.cache_dir);
   SceneContactStats stats;
   SimulationResult r;
   {
@@ -86,7 +84,6 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
     try {
       if (a.solver == "full") {
         SceneReferenceOptions ro;
-        ro.cache_dir = o.cache_dir;
         r = run_scene_reference(scene, ro, &stats);
       } else {
         r = run_scene(scene, o, &stats);

@@ -15,6 +15,7 @@
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/line_plot_svg.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene_assets/scene_assets.hpp"
 #include "sflsh/scene/scene_run.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 
@@ -79,7 +80,7 @@ StressCaseResult scene_case(const Avatar& avatar, const StressSuiteOptions& o, c
   for (BodyDescription& b : scene.bodies) b.avatar = std::filesystem::absolute(o.avatar_path).string();
   std::filesystem::remove_all(tmp, ec);
   require(scene.bodies.size() == 1, path, ": the stress suite runs one-body scenes, this one has ", scene.bodies.size());
-  validate_scene_files(scene);
+  prepare_scene_assets(scene, "", false);  // mesh shapes baked (no cache)
   if (spec.dt > 0) scene.solver.dt = spec.dt;
   const double dt = scene.solver.dt;
   scene.solver.seconds = double(o.steps) * dt;

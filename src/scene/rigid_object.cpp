@@ -4,7 +4,6 @@
 #include "sflsh/geometry/grid_sdf.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/io/mesh_export.hpp"
-#include "sflsh/meshing/mesh_sdf_bake.hpp"
 
 namespace sflsh {
 namespace {
@@ -25,7 +24,7 @@ geometry::MassProperties mass_of(const Shape& shape, const RigidObjectDescriptio
 
 }  // namespace
 
-RigidObjectModel make_rigid_object(const RigidObjectDescription& o, const std::string& cache_dir) {
+RigidObjectModel make_rigid_object(const RigidObjectDescription& o) {
   RigidObjectModel m;
   const ShapeDescription& s = o.shape;
   const bool dynamic = o.kind == ObjectKind::Dynamic;
@@ -69,15 +68,10 @@ RigidObjectModel make_rigid_object(const RigidObjectDescription& o, const std::s
         const io::ImportedMesh mesh = io::read_mesh(s.mesh_file);
         m.surface.vertices = mesh.vertices * s.mesh_scale;
         m.surface.faces = mesh.faces;
-        require_closed_mesh(m.surface.vertices, m.surface.faces, s.mesh_file);
-        MeshSdfBakeOptions bo;
-        bo.voxel_size = s.voxel_size;
-        bo.padding = s.padding;
-        bo.band = s.band;
-        MeshSdfBakeReport rep;
-        m.field = std::make_shared<geometry::GridSdf>(
-            load_or_bake_mesh_sdf(s.mesh_file, s.mesh_scale, bo, cache_dir, &rep));
-        m.bake_report = rep.describe();
+        require(s.baked_sdf != nullptr, s.mesh_file, ": the mesh's SDF is not baked (the sflsh commands bake it; "
+                "a program calls prepare_scene_assets, sflsh/scene_assets/scene_assets.hpp)");
+        m.field = s.baked_sdf;
+        m.bake_report = s.bake_report;
         if (dynamic)
           m.mass = o.density > 0
                        ? geometry::mesh_mass_properties(m.surface.vertices, m.surface.faces, o.density)

@@ -15,7 +15,6 @@
 #include "sflsh/core/time_step.hpp"
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/mesh_export.hpp"
-#include "sflsh/meshing/mesh_sdf_bake.hpp"
 #include "sflsh/motion/builtin_motions.hpp"
 
 namespace sflsh {
@@ -882,18 +881,5 @@ void write_scene_description(const SceneDescription& scene, const std::string& p
   out.commit();
 }
 
-void validate_scene_files(const SceneDescription& scene) {
-  for (const auto& o : scene.objects) {
-    if (o.shape.type != ShapeType::Mesh) continue;
-    const std::string where = o.shape.location.empty() ? "objects." + o.name + ".shape" : o.shape.location;
-    io::ImportedMesh m;
-    try {
-      m = io::read_mesh(o.shape.mesh_file);
-    } catch (const Error& e) {
-      fail(where, ": ", e.what());
-    }
-    require_closed_mesh(m.vertices, m.faces, where + ": " + o.shape.mesh_file);
-  }
-}
 
 }  // namespace sflsh

@@ -59,7 +59,6 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   const SceneDescription sc = reference_scene(scene);
   SceneSessionOptions so;
   so.progress = false;
-  so.cache_dir = opt.cache_dir;
   // The session supplies the inputs (bones, object and tool poses) and the result's layout.
   SceneSession session(sc, so);
   const Simulator& sim = session.simulator();
@@ -81,7 +80,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     d.name = name;
     d.shape = shape;
     d.kind = kind;
-    FullFemObstacle ob{name, make_rigid_object(d, opt.cache_dir).field, sc.contact.pressure_stiffness,
+    FullFemObstacle ob{name, make_rigid_object(d).field, sc.contact.pressure_stiffness,
                        sc.contact.patch_spacing};
     fem.add_obstacle(std::move(ob));
     for (size_t i = 0; i < r.objects.size(); ++i)

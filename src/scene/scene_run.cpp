@@ -58,7 +58,6 @@ std::string SceneContactStats::describe() const {
 SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& opt, SceneContactStats* stats) {
   SceneSessionOptions so;
   so.progress = opt.progress;
-  so.cache_dir = opt.cache_dir;
   so.body_push_limit = opt.body_push_limit;
   SceneSession session(sc, so);
   const Simulator& sim = session.simulator();

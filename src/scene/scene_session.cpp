@@ -316,7 +316,7 @@ void SceneSession::Impl::build() {
   for (size_t i = 0; i < sc.objects.size(); ++i) {
     SceneObject& o = objects[i];
     o.desc = &sc.objects[i];
-    o.model = make_rigid_object(*o.desc, opt.cache_dir);
+    o.model = make_rigid_object(*o.desc);
     if (!o.model.bake_report.empty() && opt.progress) std::cerr << o.desc->name << ": " << o.model.bake_report << "\n";
     if (o.desc->kind == ObjectKind::Dynamic) {
       o.model_index = mb.add_body({o.desc->name, nullptr, true});
@@ -416,7 +416,7 @@ void SceneSession::Impl::build() {
       as_object.name = t.desc->name + "/jaw" + std::to_string(j);
       as_object.shape = t.desc->jaws[j].shape;
       as_object.kind = ObjectKind::Kinematic;
-      SceneTool::Jaw jaw{as_object.name, make_rigid_object(as_object, opt.cache_dir), Isometry::Identity(),
+      SceneTool::Jaw jaw{as_object.name, make_rigid_object(as_object), Isometry::Identity(),
                          t.desc->jaws[j].side};
       jaw.offset.translation() = t.desc->jaws[j].offset;
       t.jaws.push_back(std::move(jaw));
@@ -426,37 +426,35 @@ void SceneSession::Impl::build() {
       as_object.name = t.desc->name;
       as_object.shape = t.desc->shape;
       as_object.kind = ObjectKind::Kinematic;
-      t.shape = make_rigid_object(as_object, opt.cache_dir);
+      t.shape = make_rigid_object(as_object);
     }
     for (const SceneBody& b : bodies) {
-      if (t.desc->has_shape) {
-        auto& pts = samples[b.avatar.get()];
-        if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
-        SdfContactOptions co;
-        co.stiffness = c.body_object_stiffness;
-        co.friction = c.friction;
-        auto term = std::make_shared<const SdfContactTerm>(t.desc->name, *pts, t.shape.field, Isometry::Identity(),
-                                                           coupled, co);
-        if (coupled) {
-          mb.add_term(term, {b.model_index, t.model_index});
+      // A shape of the tool (its own, or a jaw) touching body b: with contact.patch a kinematic
+      // tool gets the face-sampled contact and its patch, like an object; a coupled (dynamic)
+      // tool keeps the per-sample penalty.
+      auto add_shape_contact = [&](const std::string& frame, const geometry::SdfPtr& field) {
+        std::shared_ptr<const EnergyTerm> term;
+        if (c.patch && !coupled) {
+          ContactPatchOptions po;
+          po.pressure_stiffness = c.pressure_stiffness;
+          po.spacing = c.patch_spacing;
+          po.patch_radius = c.patch_radius;
+          term = std::make_shared<const ContactPatchTerm>(frame, *b.avatar, field, Isometry::Identity(), false, po);
         } else {
-          mb.add_term(term, {b.model_index});
+          auto& pts = samples[b.avatar.get()];
+          if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
+          SdfContactOptions co;
+          co.stiffness = c.body_object_stiffness;
+          co.friction = c.friction;
+          term = std::make_shared<const SdfContactTerm>(frame, *pts, field, Isometry::Identity(), coupled, co);
         }
-      }
-      for (const SceneTool::Jaw& jaw : t.jaws) {
-        auto& pts = samples[b.avatar.get()];
-        if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
-        SdfContactOptions co;
-        co.stiffness = c.body_object_stiffness;
-        co.friction = c.friction;
-        auto term = std::make_shared<const SdfContactTerm>(jaw.name, *pts, jaw.model.field, Isometry::Identity(),
-                                                           coupled, co);
-        if (coupled) {
+        if (coupled)
           mb.add_term(term, {b.model_index, t.model_index});
-        } else {
+        else
           mb.add_term(term, {b.model_index});
-        }
-      }
+      };
+      if (t.desc->has_shape) add_shape_contact(t.desc->name, t.shape.field);
+      for (const SceneTool::Jaw& jaw : t.jaws) add_shape_contact(jaw.name, jaw.model.field);
       if (!t.desc->sensors.empty()) {
         GraspOptions go;
         for (const ToolSensorDescription& sd : t.desc->sensors) go.sensors.push_back({sd.origin, sd.direction, sd.range});

@@ -2,6 +2,7 @@
 // error naming the file, the line and the key path, and a scene with a
 // non-default value in every field survives a write/read round trip.
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene_assets/scene_assets.hpp"
 
 #include <gtest/gtest.h>
 
@@ -112,7 +113,9 @@ objects:
   EXPECT_EQ(s.output.out, "result.h5");
   EXPECT_TRUE(s.contact.all_pairs);
   EXPECT_NE(o.shape.location.find("s.yaml:8: objects[0].shape"), std::string::npos) << o.shape.location;
-  validate_scene_files(s);  // ball.obj is closed
+  SceneDescription baked = s;
+  prepare_scene_assets(baked, "", false);  // ball.obj is closed: baked
+  EXPECT_NE(baked.objects[0].shape.baked_sdf, nullptr);
 }
 
 TEST(SceneDescription, ToolsParseRoundTripAndRejectBadInput) {
@@ -334,13 +337,13 @@ TEST(SceneDescription, MissingFiles) {
   test::expect_error([] { read_scene_description("/nonexistent/scene.yaml"); }, {"/nonexistent/scene.yaml", "not found"});
 }
 
-TEST(SceneDescription, NonClosedMeshIsRejectedByValidateSceneFiles) {
+TEST(SceneDescription, NonClosedMeshIsRejectedWhenTheSceneIsPrepared) {
   SceneFolder folder;
   const std::string path = folder.write("s.yaml",
                                         "bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1}\nobjects:\n"
                                         "  - name: cup\n    shape: {type: mesh, file: cup.obj}\n");
-  const SceneDescription s = read_scene_description(path);  // reading does not open meshes
-  test::expect_error([&] { validate_scene_files(s); },
+  SceneDescription s = read_scene_description(path);  // reading does not open meshes
+  test::expect_error([&] { prepare_scene_assets(s, "", false); },
                      {"s.yaml:7:", "objects[0].shape", "cup.obj", "closed", "3 boundary edges"});
 }
 

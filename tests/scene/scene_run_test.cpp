@@ -12,6 +12,7 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene_assets/scene_assets.hpp"
 #include "sflsh/scene/scene_run.hpp"
 #include "scene/box_avatar_fixture.hpp"
 #include "test_support.hpp"
@@ -146,7 +147,7 @@ objects:
       - {time: 0.0, position: [0, 0.06, 0]}
       - {time: 0.5, position: [0, 0.045, 0]}
 )"));
-  validate_scene_files(sc);
+  prepare_scene_assets(sc, "", false);  // bakes the cube's SDF (the runtime does not bake)
   SceneContactStats stats;
   SceneRunOptions opt;
   opt.progress = false;
@@ -175,7 +176,7 @@ objects:
   - {name: lid, shape: {type: mesh, file: open.obj}}
 )"));
   try {
-    validate_scene_files(bad);
+    prepare_scene_assets(bad, "", false);
     ADD_FAILURE() << "an open mesh was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("open.obj"), std::string::npos) << e.what();

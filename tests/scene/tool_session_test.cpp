@@ -372,3 +372,40 @@ TEST_F(ToolSession, AfterTheRunEndsTheDeviceGetsZeroForceAndStatusEnded) {
   EXPECT_EQ(fb->torque, Vec3::Zero());
   EXPECT_DOUBLE_EQ(fb->sim_time, end_time);
 }
+
+TEST_F(ToolSession, WithContactPatchAKinematicToolDentsLikeTheSameObject) {
+  // A 1 cm probe pressed 4 mm into the top as a kinematic tool, and the same
+  // sphere on the same keyframes as a kinematic object: with contact.patch both
+  // are the face-sampled contact with a full-space patch, so the tool feels
+  // exactly the force the object puts on the body, and the patch is there.
+  const std::string head = R"(
+solver: {dt: 1/100, seconds: 0.2, gravity: [0, 0, 0]}
+contact: {friction: 0, patch: {radius: 0.015}}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+)";
+  const std::string keys = R"(
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.045, 0.0]}
+      - {time: 0.2, position: [0.0, 0.036, 0.0]}
+)";
+  SceneSession tool(read_scene_description(write_scene(head + "tools:\n  - name: probe\n    shape: {type: sphere, radius: 0.01}" + keys)), quiet());
+  SceneSession object(read_scene_description(write_scene(
+                          head + "objects:\n  - name: probe\n    kind: kinematic\n    shape: {type: sphere, radius: 0.01}" + keys)),
+                      quiet());
+  Vec3 object_force = Vec3::Zero();
+  double patch_nodes = 0;
+  for (int k = 0; k < 20; ++k) {
+    tool.advance();
+    const StepReport& rep = object.advance();
+    object_force.setZero();
+    for (const TermQuantityReport& q : rep.quantities)
+      if (q.term == "contact:probe" && q.name == "force") object_force = Vec3(q.value[0], q.value[1], q.value[2]);
+    for (const TermQuantityReport& q : tool.last_report().quantities)
+      if (q.term == "contact:probe" && q.name == "patch_nodes") patch_nodes = std::max(patch_nodes, q.value[0]);
+  }
+  EXPECT_GT(patch_nodes, 0);
+  EXPECT_LT(object_force.y(), -0.1);  // the probe presses the body down
+  EXPECT_EQ(tool.tool_state(0).force, -object_force);  // the body pushes the tool up by as much
+  EXPECT_EQ(tool.body_surface(0), object.body_surface(0));  // the same dent
+}

@@ -23,10 +23,11 @@ struct RigidObjectModel {
   std::string bake_report;                ///< mesh objects: what the SDF bake or cache did
 };
 
-/// Builds field, surface and (for dynamic objects) mass properties. Mesh
-/// objects are read (and checked closed) and baked, or loaded from
-/// `cache_dir` ("" = no cache). Errors name the object's location in the scene file.
-RigidObjectModel make_rigid_object(const RigidObjectDescription& object, const std::string& cache_dir);
+/// Builds field, surface and (for dynamic objects) mass properties. A mesh
+/// object's surface is read from its file and its field is the shape's
+/// baked_sdf (prepare_scene_assets bakes it; without it: an error). Errors
+/// name the object's location in the scene file.
+RigidObjectModel make_rigid_object(const RigidObjectDescription& object);
 
 /// The shape frame's pose at time t (s): the fixed pose of static and dynamic
 /// objects (their initial one), or the keyframes of a kinematic object

@@ -118,14 +118,15 @@
 // non-finite numbers, out-of-range values (negative mass, radius, density,
 // ...), duplicate names, pairs naming an unknown body/object, and avatar,
 // motion, material or mesh files that do not exist. Whether a mesh is closed
-// is checked by validate_scene_files (it reads the meshes) and again when a
-// mesh is baked.
+// is checked when it is baked (prepare_scene_assets, before a session is built).
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/geometry/sdf.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/newton_step.hpp"
 
@@ -168,8 +169,13 @@ struct ShapeDescription {
   double voxel_size = 0.005;           ///< mesh: grid SDF spacing (m)
   double padding = 0.02;               ///< mesh: grid room around the mesh (m)
   double band = 0;                     ///< mesh: exact band (m), 0 = full grid
+  /// mesh: its grid SDF, baked (or loaded from the cache) by prepare_scene_assets
+  /// (sflsh/scene_assets/scene_assets.hpp) before the scene is built: the
+  /// runtime reads the grid and never bakes (baking takes CGAL). Not written back.
+  std::shared_ptr<const geometry::Sdf> baked_sdf;
+  std::string bake_report;             ///< what the bake or the cache did (one line)
   /// Where the shape was read ("scene.yaml:12: objects[2].shape"), for later
-  /// errors (validate_scene_files, baking); not written back.
+  /// errors (baking); not written back.
   std::string location;
 };
 
@@ -278,7 +284,8 @@ struct ContactDescription {
   /// pressure stiffness, and a full-space patch under it
   /// (sim/energies/contact_patch.hpp), for static and kinematic objects.
   /// Frictionless: refused with friction > 0; a dynamic object is refused
-  /// when the scene is built. Tools keep the per-sample penalty.
+  /// when the scene is built. Kinematic tools (and their jaws) get it too;
+  /// coupled tools keep the per-sample penalty.
   bool patch = false;
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
   double pressure_stiffness = kDefaultPressureStiffness;      ///< N/m³
@@ -337,10 +344,5 @@ std::string scene_description_yaml(const SceneDescription& scene);
 
 /// Writes scene_description_yaml(scene) to `path` (atomic).
 void write_scene_description(const SceneDescription& scene, const std::string& path);
-
-/// Checks what reading does not: every mesh object's file is a closed
-/// manifold triangle mesh (io::read_mesh + check_surface). Throws
-/// "FILE:LINE: objects[i].shape: MESHFILE: ..." otherwise.
-void validate_scene_files(const SceneDescription& scene);
 
 }  // namespace sflsh

@@ -21,7 +21,6 @@ namespace sflsh {
 
 struct SceneReferenceOptions {
   bool progress = true;
-  std::string cache_dir;       ///< baked mesh SDFs ("" = no cache)
   int max_iterations = 50;     ///< Newton iterations per step at most (FullFemOptions)
 };
 

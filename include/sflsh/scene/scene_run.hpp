@@ -16,8 +16,6 @@ namespace sflsh {
 
 struct SceneRunOptions {
   bool progress = true;
-  /// Folder of baked mesh SDFs ("" = no cache): the CLI passes the default cache.
-  std::string cache_dir;
   /// Root push limit of bodies in body contact, as a fraction of body weight.
   double body_push_limit = 0.25;
 };
@@ -57,8 +55,8 @@ struct SceneContactStats {
   void write_tool_log(const std::string& path) const;
 };
 
-/// Simulates `scene` (read and checked by read_scene_description and
-/// validate_scene_files) and returns the result with every output frame.
+/// Simulates `scene` (read by read_scene_description, its mesh shapes and
+/// `avatar: default` prepared by prepare_scene_assets) and returns the result with every output frame.
 /// Throws naming the body/object on inputs the runtime rejects (e.g. an avatar
 /// without capsules in body contact), and SimulationStopped (with the frames
 /// made so far, marked incomplete) when the state or an energy becomes

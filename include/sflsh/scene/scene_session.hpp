@@ -45,8 +45,6 @@ namespace sflsh {
 struct SceneSessionOptions {
   /// Print what building the scene does (mesh bakes, stream ports) to stderr.
   bool progress = true;
-  /// Folder of baked mesh SDFs ("" = no cache): the CLI passes the default cache.
-  std::string cache_dir;
   /// Root push limit of bodies in body contact, as a fraction of body weight.
   double body_push_limit = 0.25;
   /// Open the UDP ports of tools with a `pose_stream` (false: such tools hold
