@@ -47,7 +47,7 @@ describe() {
     avatar) echo "the default avatar (work file; quick: K = 16)" ;;
     bench) echo "bench.md bench.csv bench.svg: sflsh bench against the full FEM" ;;
     contact) echo "contact_patch.md contact_patch_probe.svg: sflsh bench-contact, three probes" ;;
-    hertz) echo "hertz.md: the full FEM against Hertz (test_sim)" ;;
+    hertz) echo "hertz.md: the full FEM against Hertz (test_reference)" ;;
     stress) echo "stress.csv stress.svg: sflsh stress, shake at dt 1/30" ;;
     stress_suite) echo "stress_suite.md .csv .svg: sflsh stress-suite" ;;
     throughput) echo "throughput.md throughput.csv: sflsh bench-throughput" ;;
@@ -150,7 +150,7 @@ START=$SECONDS
 
 if [ "$BUILD_FIRST" = 1 ]; then
   targets=(--target sflsh)
-  [[ " $STEPS " == *" hertz "* ]] && targets+=(--target test_sim)
+  [[ " $STEPS " == *" hertz "* ]] && targets+=(--target test_reference)
   [[ " $STEPS " == *" shapes "* ]] && targets+=(--target test_precompute)
   begin build
   run env SFLSH_BUILD_DIR="$BUILD" bash scripts/build.sh "${targets[@]}" || {
@@ -190,7 +190,7 @@ for step in $STEPS; do
     stamp "$d/contact_probe.svg" "$OUT/contact_patch_probe.svg" ;;
   hertz)
     tmp="$WORK/hertz.md"; rm -f "$tmp"
-    run env SFLSH_HERTZ_MD="$tmp" "$BUILD_ABS/test_sim" --gtest_filter=FullFemHertz.DISABLED_ConvergenceTable \
+    run env SFLSH_HERTZ_MD="$tmp" "$BUILD_ABS/test_reference" --gtest_filter=FullFemHertz.DISABLED_ConvergenceTable \
       --gtest_also_run_disabled_tests
     stamp "$tmp" "$OUT/hertz.md" ;;
   stress)

@@ -21,7 +21,7 @@
 #include "sflsh/scene/result_export.hpp"
 #include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_description.hpp"
-#include "sflsh/scene/scene_reference_run.hpp"
+#include "sflsh/reference/scene_reference_run.hpp"
 #include "sflsh/scene/scene_run.hpp"
 #include "sflsh/scene_assets/scene_assets.hpp"
 #include "sflsh/scene/simulation_run.hpp"

@@ -25,7 +25,7 @@
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/posed_points.hpp"
 
 namespace sflsh {

@@ -14,7 +14,7 @@
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/io/line_plot_svg.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
 

@@ -6,7 +6,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/scene/simulation_run.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 
 namespace sflsh {
 

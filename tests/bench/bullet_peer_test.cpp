@@ -5,7 +5,7 @@
 #include <BulletSoftBody/btDeformableNeoHookeanForce.h>
 
 #include "sflsh/bench/bullet_peer.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/material.hpp"
 #include "sim/synthetic_avatar.hpp"
 

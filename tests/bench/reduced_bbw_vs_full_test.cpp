@@ -18,7 +18,7 @@
 
 #include "sflsh/basis/bounded_biharmonic.hpp"
 #include "sflsh/basis/handle_placement.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sim/synthetic_avatar.hpp"
 

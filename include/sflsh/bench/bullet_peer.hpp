@@ -3,7 +3,7 @@
 // btDeformableNeoHookeanForce, implicit backward Euler with Bullet's Newton–Krylov
 // solve) run on the avatar's own tet mesh, in the same process as `sflsh bench`.
 //
-// What is shared with the full-FEM reference (sim/full_fem.hpp):
+// What is shared with the full-FEM reference (reference/full_fem.hpp):
 //   - the tet mesh (#N nodes, #T tets, one Bullet tetra per tet) and the lumped
 //     nodal masses m_n = Σ_{t∋n} ρ_t V_t / 4 (Bullet's nodal masses are set to them);
 //   - the prescribed nodes: every node whose role is not Simulated (Bone and

@@ -1,5 +1,5 @@
 #pragma once
-// Observations from the full-FEM reference (sim/full_fem.hpp: every tet,
+// Observations from the full-FEM reference (reference/full_fem.hpp: every tet,
 // Newton to convergence) instead of the reduced model: the realistic case for
 // `sflsh fit`, where the model that is fitted is not the one that made the data.
 #include <memory>

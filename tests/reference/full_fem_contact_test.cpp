@@ -16,10 +16,10 @@
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
-#include "synthetic_avatar.hpp"
+#include "sim/synthetic_avatar.hpp"
 
 namespace sflsh {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// A scene run with the full-FEM reference (sim/full_fem.hpp) in place of the
+// A scene run with the full-FEM reference (reference/full_fem.hpp) in place of the
 // reduced soft tissue: `sflsh simulate scene.yaml --solver full`, so that a
 // user can check a scene of their own against the ground truth.
 //

@@ -1,4 +1,4 @@
-#include "sflsh/scene/scene_reference_run.hpp"
+#include "sflsh/reference/scene_reference_run.hpp"
 
 #include <iostream>
 
@@ -7,7 +7,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/scene/rigid_object.hpp"
 #include "sflsh/scene/scene_session.hpp"
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 
 namespace sflsh {
 namespace {

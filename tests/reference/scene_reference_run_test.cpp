@@ -1,6 +1,6 @@
 // `simulate scene.yaml --solver full`: the full-FEM reference driven by the
 // scene session's inputs, on the small box avatar (6 cm, top at y = 0.03 m).
-#include "sflsh/scene/scene_reference_run.hpp"
+#include "sflsh/reference/scene_reference_run.hpp"
 
 #include <gtest/gtest.h>
 

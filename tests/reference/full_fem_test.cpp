@@ -1,8 +1,8 @@
 // The full-FEM reference: convergence, stationarity, rest, equilibrium.
 #include <gtest/gtest.h>
 
-#include "sflsh/sim/full_fem.hpp"
-#include "synthetic_avatar.hpp"
+#include "sflsh/reference/full_fem.hpp"
+#include "sim/synthetic_avatar.hpp"
 
 namespace sflsh {
 namespace {

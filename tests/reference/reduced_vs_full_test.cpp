@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
-#include "synthetic_avatar.hpp"
+#include "sim/synthetic_avatar.hpp"
 
 namespace sflsh {
 namespace {

@@ -1,4 +1,4 @@
-#include "sflsh/sim/full_fem.hpp"
+#include "sflsh/reference/full_fem.hpp"
 
 #include <algorithm>
 #include <cmath>
