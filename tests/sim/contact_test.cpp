@@ -360,6 +360,21 @@ TEST(SdfContact, BroadPhaseKeepsEveryPenetratingSampleAndNothingFar) {
   EXPECT_THROW(begin_term_step(term, ctx), Error);
 }
 
+/// The avatar at rest: identity bones, z = 0.
+Configuration rest(const Avatar& a) {
+  Configuration q;
+  q.bones.assign(24, Isometry::Identity());
+  q.z = VecX::Zero(a.num_reduced());
+  return q;
+}
+
+/// The lowest world y of the term's samples at q.
+double lowest_sample_y(const SdfContactTerm& term, const Configuration& q) {
+  double bottom = 1e9;
+  for (int p = 0; p < term.samples().size(); ++p) bottom = std::min(bottom, term.samples().world_point(p, q).y());
+  return bottom;
+}
+
 TEST(SdfContact, BroadPhaseLooksAheadByTheSkinsAndTheObjectsMotion) {
   // The reach of the broad phase (sdf_contact.hpp, SdfContactOptions::margin):
   // margin + twice a sample's displacement over the last step + the object's
@@ -370,11 +385,8 @@ TEST(SdfContact, BroadPhaseLooksAheadByTheSkinsAndTheObjectsMotion) {
   SdfContactOptions o;
   o.cluster_size = 0.03;
   const SdfContactTerm term("floor", PosedPoints::at_surface(a), plane, Isometry::Identity(), false, o);
-  Configuration q;
-  q.bones.assign(24, Isometry::Identity());
-  q.z = VecX::Zero(a.num_reduced());
-  double bottom = 1e9;
-  for (int p = 0; p < term.samples().size(); ++p) bottom = std::min(bottom, term.samples().world_point(p, q).y());
+  const Configuration q = rest(a);
+  const double bottom = lowest_sample_y(term, q);
   std::map<std::string, WorldFrame> frames;
   frames["floor"].pose.translation() = Vec3(0, bottom - 0.04, 0);
   auto lowest_is_candidate = [&](std::vector<Bound>& bodies) {
@@ -437,11 +449,8 @@ TEST(SdfContact, FrictionIsCarriedByAKinematicObjectsRotation) {
   SdfContactOptions o;
   o.friction = 0.5;
   const SdfContactTerm term("floor", PosedPoints::at_surface(a), plane, Isometry::Identity(), false, o);
-  Configuration q;
-  q.bones.assign(24, Isometry::Identity());
-  q.z = VecX::Zero(a.num_reduced());
-  double bottom = 1e9;
-  for (int p = 0; p < term.samples().size(); ++p) bottom = std::min(bottom, term.samples().world_point(p, q).y());
+  const Configuration q = rest(a);
+  const double bottom = lowest_sample_y(term, q);
   std::map<std::string, WorldFrame> frames;
   frames["floor"].pose.translation() = Vec3(-1.0, bottom + 0.001, 0);
   frames["floor"].angular_velocity = Vec3(0, 2.0, 0);
