@@ -1,5 +1,5 @@
 // `sflsh fit`: per-region material parameters from observed skin motion
-// (Ceres; issue 12).
+// (Ceres).
 #include <cmath>
 #include <filesystem>
 #include <iostream>

@@ -1,4 +1,4 @@
-// `sflsh run scene.yaml [--realtime]` (issue 11): a scene run live — tools
+// `sflsh run scene.yaml [--realtime]`: a scene run live — tools
 // driven by keyframes, pose files, live UDP devices (pose_stream) or a
 // recording (--replay) — in step with the wall clock or as fast as possible,
 // reporting the real-time factor; optional result file, per-step tool log and
@@ -35,7 +35,7 @@ struct RunArgs {
   int max_substeps = 10;
   std::string out, tool_log, record, replay, cache_dir;
   bool quiet_status = false;
-  bool serve = false;  // the browser viewer (issue 15)
+  bool serve = false;  // the browser viewer
   int port = 8080;
   std::string bind = "127.0.0.1";
 };

@@ -1,4 +1,4 @@
-// `sflsh view result.h5`: plays a result file in the browser viewer (issue 15):
+// `sflsh view result.h5`: plays a result file in the browser viewer:
 // serves the page on loopback, and plays the frames with timeline scrubbing,
 // play/pause and speed from the page (viewer/result_player.hpp).
 #include <chrono>

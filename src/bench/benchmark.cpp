@@ -369,7 +369,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
             o.handle_counts[i] != K ? "" : K == PrecomputeOptions().handles ? "default" : "default settings otherwise",
             o.handle_counts[i] == K);
   // Mean dilatation per handle cell (against the subspace's volumetric
-  // locking, issue 13) against every tet's own volume change, as before.
+  // locking) against every tet's own volume change, as before.
   const bool md = SimulatorOptions().mean_dilatation;
   reduced(default_avatar, K, h, 1, md ? "volume per tet (no mean dilatation, before)" : "mean dilatation", false, !md);
   // Time steps and Newton iterations around the default.
@@ -395,7 +395,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
     reduced(a, K, h, 1, what + " (" + std::to_string(a->elastic.size()) + " samples)", false);
   };
-  // The basis before issue 13 (bones Dirichlet 0 in every QP), for its floor
+  // The earlier basis (bones Dirichlet 0 in every QP), for its floor
   // and its simulation next to the default's.
   if (wanted("bones Dirichlet 0") || wanted("bones depth-blended")) {
     PrecomputeOptions po = o.precompute;
@@ -405,14 +405,14 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     const bool dirichlet = po.bbw.bone_condition == basis::BoneCondition::Dirichlet;
     log_info("bench: shape stage with bones " + std::string(dirichlet ? "Dirichlet" : "depth-blended"));
     const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
-    reduced(a, K, h, 1, dirichlet ? "bones Dirichlet 0 (before issue 13)" : "bones depth-blended", false);
+    reduced(a, K, h, 1, dirichlet ? "bones Dirichlet 0 (the earlier basis)" : "bones depth-blended", false);
   }
-  // Handle allocation (issue 13's "handle placement"): more handles for the
+  // Handle allocation ("handle placement"): more handles for the
   // small regions (calf, arms, neck, chest) at the same K, taken from the
   // large ones by the same apportionment.
   for (int m : {2, 4, 6}) {
     const std::string what =
-        "at least " + std::to_string(m) + " handles per region" + (m == 2 ? " (before session 12)" : "");
+        "at least " + std::to_string(m) + " handles per region" + (m == 2 ? " (the earlier minimum)" : "");
     if (m == o.precompute.placement.min_per_region || !wanted(what)) continue;
     PrecomputeOptions po = o.precompute;
     po.handles = K;
@@ -450,14 +450,14 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     reduced(lumped_exact, K, h, 1, "elastic on all tets + lumped nodal inertia", false);
   }
   // The other inertia cubature: the data-oblivious samples at the handles
-  // (before issue 13's fit), or the mass-fitted one if the default is that.
+  // (before the mass fit), or the mass-fitted one if the default is that.
   {
     PrecomputeOptions po = o.precompute;
     po.handles = K;
     po.inertia_samples_per_cell = o.precompute.inertia_samples_per_cell > 0 ? 0 : 2;
     const std::string what = po.inertia_samples_per_cell > 0 ? "inertia mass-fitted"
                                                              : "inertia at the handles (data-oblivious, before)";
-    // With both of issue 13's accuracy changes as the defaults: the setting before them.
+    // With both accuracy changes (mean dilatation, mass-fitted inertia) as the defaults: the setting before them.
     const std::string before = "previous default (inertia at the handles, volume per tet)";
     const bool both_default = po.inertia_samples_per_cell == 0 && SimulatorOptions().mean_dilatation;
     if (wanted(what) || (both_default && wanted(before))) {
@@ -465,7 +465,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
       const auto a = std::make_shared<Avatar>(precompute_shape(tv, model, o.betas, po));
       const std::string label = what + " (" + std::to_string(a->inertia.size()) + " samples)";
       reduced(a, K, h, 1, label, false);
-      // The combination issue 13 measured: mean dilatation with the fitted inertia.
+      // The combination measured: mean dilatation with the fitted inertia.
       if (po.inertia_samples_per_cell > 0 && !SimulatorOptions().mean_dilatation)
         reduced(a, K, h, 1, label + " + mean dilatation", false, true);
       if (both_default) reduced(a, K, h, 1, before, false, false);
@@ -479,7 +479,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     if (diverged) label += " (diverged at step " + std::to_string(diverged) + "; error over the " + std::to_string(tr.u.size()) + " frames before)";
     add(tr, nullptr, "peer", label, 0, h, iters, false);
   }
-  // Floors of a candidate basis without simulating it (issue 13: "report the floor for the
+  // Floors of a candidate basis without simulating it ("report the floor for the
   // alternatives"): a row with the floor and its regions, the simulated figures NaN.
   auto add_floor_only = [&](const std::vector<Points>& fl, const std::string& label, int handles) {
     const double nan = kNaN;

@@ -188,7 +188,7 @@ std::string key_prefix(const BodyModel& model, const PrecomputeOptions& o) {
   s << "|handles," << o.handles << ',' << o.handle_positions.rows();
   for (Eigen::Index i = 0; i < o.handle_positions.size(); ++i) s << ',' << o.handle_positions.data()[i];
   s << "|placement," << o.placement.thickness_exponent << ',' << o.placement.seed;
-  // 2: the minimum until session 12, which the keys of files built then did not spell out.
+  // 2: the earlier minimum, which the keys of files built with it did not spell out.
   if (o.placement.min_per_region != 2) s << ",min_per_region," << o.placement.min_per_region;
   s << "|bbw," << o.bbw.max_iterations << ',' << o.bbw.pdas_iterations << ',' << o.bbw.multiplier_tolerance << ','
     << o.bbw.drop_tolerance << ',' << o.bbw.initial_radius_factor << ',' << o.bbw.max_border_columns << ','

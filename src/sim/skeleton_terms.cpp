@@ -59,7 +59,7 @@ std::vector<double> joint_subtree_inertia(const Avatar& avatar, const std::vecto
   for (int i = 0; i < J; ++i) {
     // Body i is moved by joint i and all its ancestors. (Written out, not
     // add_subtree_bodies: this exact expression keeps the results of the
-    // Segments rule bit-identical to before issue 13, tests/scene/golden_run_test.cpp.)
+    // Segments rule bit-identical to the earlier code, tests/scene/golden_run_test.cpp.)
     for (int j = i; j >= 0; j = avatar.parents[j]) {
       const Vec3 d = bodies[i].com_rest - avatar.joints_rest.row(j).transpose();
       I[j] += bodies[i].inertia_rest + bodies[i].mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());

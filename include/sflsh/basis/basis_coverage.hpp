@@ -1,5 +1,5 @@
 #pragma once
-// How much of the simulated skin the reduced basis can move (issue 13): the
+// How much of the simulated skin the reduced basis can move: the
 // share of Simulated outer-surface nodes whose handle weights sum to at least
 // a threshold, overall and per body region, with the handles per region. A
 // node with Σ_k W_k = 0 is skinned rigidly although it is "simulated".

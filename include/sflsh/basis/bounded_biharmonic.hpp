@@ -58,7 +58,7 @@ enum class BoneCondition {
   /// every QP. On a thin shell of flesh (the default body: 98 % of the
   /// Simulated nodes are on the skin, 78 % of those share a tet edge with a
   /// bone node) the weights fall from 1 at a handle to 0 within a few shell
-  /// thicknesses, so most of the skin keeps Σ_k W_k ≈ 0 (issue 13: 27 % of the
+  /// thicknesses, so most of the skin keeps Σ_k W_k ≈ 0 (27 % of the
   /// skin nodes reach 0.5 at K = 64).
   Dirichlet,
   /// The QPs hold only the handles and the Skinned nodes fixed (bone nodes are

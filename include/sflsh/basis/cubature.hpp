@@ -4,7 +4,7 @@
 // is integrated exactly when each sample's weight is the integral of its
 // weight field, c_k = ∫ W_k dV. The same samples can serve the elastic and the
 // inertial integrals (Avatar::elastic and Avatar::inertia may hold copies):
-// the method needs no training data for either. Since issue 13 precompute
+// the method needs no training data for either. Precompute now
 // refits both, still without training data: elasticity to the basis'
 // stiffness (stiffness_fitted_cubature.hpp), inertia to the lumped mass
 // matrix (mass_fitted_cubature.hpp).

@@ -1,5 +1,5 @@
 #pragma once
-// Depth fraction of the soft tissue (issue 13): a scalar field b over the tet
+// Depth fraction of the soft tissue: a scalar field b over the tet
 // mesh that is 0 on the Dirichlet nodes (bone surface, skinned parts) and 1 on
 // the skin, harmonic in between:
 //   L_ff b_f = −L_fb b_b,   b_b = 0 at Bone/Skinned nodes, 1 at skin nodes,

@@ -13,7 +13,7 @@
 //     (geodesic, over the tet edge graph) from every handle chosen so far and
 //     from the Dirichlet nodes (Bone, Skinned).
 // Why regions: a single farthest-point sampling measured from the bones put all
-// 64 handles of the default body on the torso (issue 13): a limb's flesh is a
+// 64 handles of the default body on the torso: a limb's flesh is a
 // thin shell, so every limb node is "close to bone" and the thick torso won
 // every pick, leaving legs and arms with no soft weight at all.
 #include <vector>
@@ -45,7 +45,7 @@ struct HandlePlacementOptions {
   /// minimum, or a region has fewer nodes). Smaller regions — e.g. the few
   /// Simulated nodes whose tets are labelled head or foot at the border of a
   /// skinned part — get handles only in proportion to their weight.
-  /// 4 since issue 13's session 12 (2 before): at K = 96 it lowers rel_err
+  /// 4 since the handle allocation change (2 before): at K = 96 it lowers rel_err
   /// on all four bench motions (mean 0.242 → 0.234) and the arms' and neck's
   /// by 10–25 % (scripts/results/handle_count_and_allocation.md).
   int min_per_region = 4;

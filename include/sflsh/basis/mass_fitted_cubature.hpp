@@ -24,7 +24,7 @@
 // W_k = 1 and the other weights vanish) lumps the reduced mass onto its
 // diagonal. Once the elastic energy is free of volumetric locking (mean
 // dilatation), that lumping is what separates the simulation from the
-// subspace's floor on inertia-driven motion (measured on `shake`, issue 13).
+// subspace's floor on inertia-driven motion (measured on `shake`).
 #include <Eigen/Sparse>
 
 #include "sflsh/asset/avatar.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The peer (issue 13 §4): Bullet 3's deformable FEM (btDeformableMultiBodyDynamicsWorld,
+// The peer: Bullet 3's deformable FEM (btDeformableMultiBodyDynamicsWorld,
 // btDeformableNeoHookeanForce, implicit backward Euler with Bullet's Newton–Krylov
 // solve) run on the avatar's own tet mesh, in the same process as `sflsh bench`.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// `sflsh bench-contact` (issue 10): the reduced model against the full-FEM
+// `sflsh bench-contact`: the reduced model against the full-FEM
 // reference under rigid contact, i.e. how well K handles represent a local
 // dent. Two scenes on one avatar shape with kinematic bones in the rest pose
 // and gravity off (so the soft displacement is the contact response alone):
@@ -13,7 +13,7 @@
 //   probe:   a kinematic sphere probe (radius 2 cm) starts 2 mm in front of the
 //            left thigh, presses 15 mm deep along the inward normal over 1.5 s
 //            (quasi-static: 1 cm/s) and is held 0.25 s; time step 1/60 s. The
-//            force–depth curve is compared (issue 11): |force| of the contact
+//            force–depth curve is compared: |force| of the contact
 //            per step against the probe's kinematic depth below the
 //            undeformed skin; force_err = |F_red − F_full| / F_full at 10 mm.
 //

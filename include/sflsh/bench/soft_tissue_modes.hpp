@@ -1,5 +1,5 @@
 #pragma once
-// The lowest vibration modes of the soft tissue with the bones held (issue 13's
+// The lowest vibration modes of the soft tissue with the bones held (the
 // second candidate basis, measured by its error floor in `sflsh bench`):
 //   K φ = ω² M φ   over the Simulated nodes, every other node fixed (Dirichlet),
 // K = Σ_t V_t G_tᵀ H_t G_t the small-strain stiffness at rest (H_t the tet's
@@ -49,8 +49,8 @@ VecX simulated_lumped_mass(const Avatar& avatar);
 /// per tet), every node that is not Simulated fixed.
 VibrationModes soft_tissue_modes(const Avatar& avatar, int count);
 
-/// Scalar skinning eigenmodes (in the spirit of Benchekroun et al. 2023, issue 13's third
-/// candidate): the lowest eigenvectors of L w = λ M w, L = Σ_t V_t μ_t G_tᵀ G_t the
+/// Scalar skinning eigenmodes (in the spirit of Benchekroun et al. 2023, the third
+/// candidate basis): the lowest eigenvectors of L w = λ M w, L = Σ_t V_t μ_t G_tᵀ G_t the
 /// shear-modulus-weighted stiffness Laplacian (μ_t from the mean of the tet's three Young's
 /// moduli and its Poisson ratio), M the lumped mass of the Simulated nodes, every other node
 /// held at 0. phi is #N by count: weights for u = W z, 3 DoFs each, like the handles' W.

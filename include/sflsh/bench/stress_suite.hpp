@@ -1,5 +1,5 @@
 #pragma once
-// `sflsh stress-suite` (issue 13 §3): a set of long stability cases on one
+// `sflsh stress-suite`: a set of long stability cases on one
 // avatar, each reported with the same figures: non-finite state, rejected and
 // damped steps, smallest det F over the elastic cubature samples, peak soft
 // displacement of the skin, and the pelvis error against the motion's root

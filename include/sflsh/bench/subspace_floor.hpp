@@ -1,5 +1,5 @@
 #pragma once
-// The error floor of a reduced basis (issue 13): the best approximation of a
+// The error floor of a reduced basis: the best approximation of a
 // nodal soft displacement within span(U), U = W ⊗ I₃ (u_i = Σ_k W_ik z_k),
 // in the mass-weighted least-squares sense, per frame:
 //   z* = argmin_z Σ_i m_i ‖u_i − Σ_k W_ik z_k‖²  ⇔  (Wᵀ M W) z* = Wᵀ M u
@@ -59,7 +59,7 @@ class VectorSubspaceProjector {
 /// is W_·k along axis c.
 MatX vector_basis(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W);
 
-/// Weights of the affine-handle basis of the same handles (issue 13's candidate, Wang et al.
+/// Weights of the affine-handle basis of the same handles (a candidate basis, Wang et al.
 /// 2015): u_i = Σ_k W_ik (t_k + A_k (x_i − c_k)), 12 DoFs per handle, as scalar weights for
 /// SubspaceProjector: #N by 4K, column k = W_·k (translation), column K + 3k + c =
 /// W_·k ∘ (x_c − c_{k,c}) (the c-th column of A_k). Where Σ_k W_ik = 1 every affine field

@@ -1,5 +1,5 @@
 #pragma once
-// `sflsh bench-throughput` (issue 13, "Throughput for many avatars"): a batch
+// `sflsh bench-throughput` ("Throughput for many avatars"): a batch
 // of independent avatars, each driven by the same motion at its own phase,
 // stepped together with sim/batch_step.hpp on 1, 2, ... threads. Reports
 // avatar-steps per second per (avatars, threads) and the speed-up over one

@@ -1,5 +1,5 @@
 #pragma once
-// The parameters `sflsh fit` estimates (issue 12): per region, the log of a
+// The parameters `sflsh fit` estimates: per region, the log of a
 // factor on its three Young's moduli ("young"), the log of its Fung constant
 // ("fung_c"), its Poisson's ratio ("poisson"); and the soft tissue's
 // stiffness-proportional damping β ("damping", one for the body, s).

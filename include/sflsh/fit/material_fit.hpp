@@ -1,6 +1,6 @@
 #pragma once
-// Fitting per-region material parameters to observed skin motion with Ceres
-// (issue 12). Residuals: simulated minus observed surface vertex positions
+// Fitting per-region material parameters to observed skin motion with Ceres.
+// Residuals: simulated minus observed surface vertex positions
 // (m), one 3-residual block per (observed frame, vertex) so a robust loss acts
 // per vertex; every block reads one shared simulation of the current
 // parameters (trajectory_sensitivity.hpp), whose forward sensitivities are the

@@ -1,5 +1,5 @@
 #pragma once
-// Observed skin motion for `sflsh fit` (issue 12): a file in the result-file
+// Observed skin motion for `sflsh fit`: a file in the result-file
 // layout (scene/result_file.hpp: /frames/time (Fr,), /frames/positions
 // (Fr,V,3), optional /meta/motion, /meta/dt, /meta/bones) or a PC2 point cache
 // (frames only; their times are i / fps). Vertices in the avatar surface's order.

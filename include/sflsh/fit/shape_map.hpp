@@ -1,5 +1,5 @@
 #pragma once
-// Material parameters as a function of body shape (issue 12; seed §4: every
+// Material parameters as a function of body shape (seed §4: every
 // shape shares one tet mesh, so a region's parameters can be interpolated):
 //   p(β) = P₀ + Σ_k β_k P_k     (p as in fit_parameters.hpp: log factors, ν, β_damping),
 // fitted jointly to several subjects' observations with Ceres, with the

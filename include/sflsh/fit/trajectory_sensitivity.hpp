@@ -1,6 +1,6 @@
 #pragma once
 // The simulated skin as a differentiable function of material parameters
-// (issue 12; seed §1: one Newton step of backward Euler per time step).
+// (seed §1: one Newton step of backward Euler per time step).
 //
 // The avatar runs with prescribed (kinematic) bones, as `sflsh simulate
 // --bones kinematic` runs it: each step solves only the reduced soft DoFs z,

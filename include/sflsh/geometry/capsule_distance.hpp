@@ -1,6 +1,6 @@
 #pragma once
 // Exact closest points between two segments and the signed gap between two
-// capsules (body ↔ body contact through bone capsules, issue 10; seed §5).
+// capsules (body ↔ body contact through bone capsules; seed §5).
 // Method: Ericson, Real-Time Collision Detection §5.1.9, with the parallel
 // case resolved at the middle of the overlap (so that the witness points of
 // two parallel bones sit symmetrically) and zero-length segments handled as

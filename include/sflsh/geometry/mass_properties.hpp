@@ -1,6 +1,6 @@
 #pragma once
 // Mass, centre of mass and inertia of a uniform-density rigid body (dynamic
-// rigid objects, issue 10: "mass and inertia from shape and density"), for
+// rigid objects: mass and inertia from shape and density), for
 // the primitive shapes (closed forms, local frame of primitive_sdfs.hpp) and
 // for a closed triangle mesh (divergence theorem over the tetrahedra spanned
 // by the origin and each face; Eberly, "Polyhedral mass properties").

@@ -1,5 +1,5 @@
 #pragma once
-// Triangle surfaces of the analytic primitives (issue 10: result files,
+// Triangle surfaces of the analytic primitives (result files,
 // exports and renders show the rigid objects), in the same local frames as
 // primitive_sdfs.hpp: centred at the origin, axes of symmetry along +Y.
 //

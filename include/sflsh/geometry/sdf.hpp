@@ -1,5 +1,5 @@
 #pragma once
-// Signed distance fields (rigid ↔ flesh contact, issue 10; seed §5). A field
+// Signed distance fields (rigid ↔ flesh contact; seed §5). A field
 // lives in its object's local frame: φ(x) < 0 inside, > 0 outside, 0 on the
 // surface (m). The contact penalty ½k·min(φ,0)² of a sample needs φ and ∇φ
 // (and ∇²φ for an exact Hessian; the Gauss–Newton one k∇φ∇φᵀ needs only ∇φ).

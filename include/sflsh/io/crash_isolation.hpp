@@ -1,5 +1,5 @@
 #pragma once
-// Containment of crashes inside third-party readers (issue 16).
+// Containment of crashes inside third-party readers.
 //
 // Fuzzing found damaged files on which Debian's libhdf5 1.10 and assimp 5.2 crash in their own
 // code, past any check this project can make before calling them: libhdf5 sizes a buffer from a

@@ -11,7 +11,7 @@
 // reproduces linear interpolation of vertex positions between frames.
 // Size: about 24 bytes per vertex per frame (10k vertices, 300 frames: 72 MB).
 //
-// Rigid parts of a scene (issue 10: objects) are separate nodes with their own
+// Rigid parts of a scene (objects) are separate nodes with their own
 // mesh and material, moved by translation and rotation channels (§3.11; one
 // LINEAR key per frame, rotations as unit quaternions x y z w, signs chosen
 // so that consecutive keys are on the same hemisphere and slerp takes the

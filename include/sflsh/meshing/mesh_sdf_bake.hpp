@@ -1,6 +1,6 @@
 #pragma once
 // Baking a closed triangle mesh into a grid SDF (rigid mesh objects in
-// contact, issue 10): the unsigned distance of each grid node comes from
+// contact): the unsigned distance of each grid node comes from
 // CGAL's AABB tree (exact closest point on the triangles), the sign from
 // CGAL::Side_of_triangle_mesh (ray parity; needs a closed mesh). The runtime
 // then samples the grid (geometry/grid_sdf.hpp) without CGAL.

@@ -1,5 +1,5 @@
 #pragma once
-// Batch precompute: one avatar per row of a shapes CSV (issue 14 §2).
+// Batch precompute: one avatar per row of a shapes CSV.
 //   Input: one β vector per line. A first line that is not all numbers is a
 //     header; a header column named "name" (any case) holds a label per row,
 //     the other columns are β in order. With a header every row must have as

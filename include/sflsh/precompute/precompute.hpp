@@ -26,7 +26,7 @@ struct PrecomputeOptions {
   ShapeOptions shape_stage;
   ThicknessMap thickness = ThicknessMap::defaults();
   /// Number of control-point handles K (ignored when handle_positions is set).
-  /// 96 since issue 13's session 12 (64 before): with the automatic second
+  /// 96 since the handle allocation change (64 before): with the automatic second
   /// Newton iteration and at least 4 handles per region it meets the issue's
   /// ≤ 0.20 on `jump` and ≤ 0.25 over the four bench motions (0.170, mean
   /// 0.234; K = 64: 0.198, 0.258 at best) at ~2× the step

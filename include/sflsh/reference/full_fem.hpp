@@ -1,5 +1,5 @@
 #pragma once
-// Full-FEM reference solver (issue 4, "the reference"): the ground truth the
+// Full-FEM reference solver ("the reference"): the ground truth the
 // reduced simulator is measured against. Same tet mesh, material and skinning as
 // the reduced model, but nodal DoFs:
 //   u_n ∈ R³ (unposed space) for every Simulated node; Bone/Skinned nodes u = 0.

@@ -1,5 +1,5 @@
 #pragma once
-// Running a scene session live (`sflsh run scene.yaml`, issue 11): in step
+// Running a scene session live (`sflsh run scene.yaml`): in step
 // with the wall clock (--realtime: RealtimeLoop, AMBF Eq. 1: N substeps of the
 // solver's dt per frame, N ≤ max_substeps, the lag beyond dropped so a slow
 // machine runs behind real time but never spirals), or as fast as it can

@@ -2,7 +2,7 @@
 // The simulation result file (HDF5): written frame by frame while a run goes
 // (ResultWriter), or at once (write_simulation_result), and read back.
 //
-// Result file (HDF5, names fixed). Format version 2 (issue 10: scenes with
+// Result file (HDF5, names fixed). Format version 2 (scenes with
 // several bodies and rigid objects); version-1 files (one body, no objects)
 // still read. B = number of bodies (1 without /bodies), O = number of objects.
 //   /meta/format_version, /meta/units, /meta/avatar, /meta/motion, /meta/dt,

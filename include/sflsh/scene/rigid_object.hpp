@@ -1,5 +1,5 @@
 #pragma once
-// A scene's rigid object made concrete (issue 10): its signed distance field
+// A scene's rigid object made concrete: its signed distance field
 // (exact for primitives, a baked grid for meshes), its surface for display,
 // its mass properties (dynamic objects) and its pose over time (kinematic
 // keyframes). Frames: the description's position/orientation place the

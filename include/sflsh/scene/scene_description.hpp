@@ -1,5 +1,5 @@
 #pragma once
-// A scene file (`sflsh simulate scene.yaml`, issue 10): bodies (avatars),
+// A scene file (`sflsh simulate scene.yaml`): bodies (avatars),
 // rigid objects, contact, solver and outputs, as plain data. Nothing here
 // builds simulation objects; the runtime turns a SceneDescription into its
 // model and state.
@@ -77,7 +77,7 @@
 //       keyframes:              # required, times >= 0 strictly increasing
 //         - {time: 0, position: [0, 1.3, 0.3], orientation: [1, 0, 0, 0]}
 //         - {time: 2, position: [0, 1.1, 0.3]}   # orientation defaults to identity
-//   tools:                      # optional: teleoperated tools (issue 11; scene_session.hpp)
+//   tools:                      # optional: teleoperated tools (scene_session.hpp)
 //     - name: pincher           # required; unique across bodies, objects and tools
 //       shape: {type: capsule, radius: 0.005, length: 0.03}  # optional contact shape (as objects')
 //       keyframes:              # the pose source: keyframes, or `pose_file` (exactly one)
@@ -239,7 +239,7 @@ struct ToolCouplingDescription {
   double haptic_gain = 1.0;             ///< the force and torque sent to the device are scaled by it
 };
 
-/// A teleoperated tool (issue 11): a frame driven by its pose source —
+/// A teleoperated tool: a frame driven by its pose source —
 /// kinematic, or with `coupling` a dynamic body pulled by its device —,
 /// optionally with a contact shape and a grasp (sensors + anchors).
 struct ToolDescription {

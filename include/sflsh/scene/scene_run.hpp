@@ -1,6 +1,6 @@
 #pragma once
-// Running a scene file as fast as possible (`sflsh simulate scene.yaml`,
-// issue 10): a SceneSession (scene_session.hpp: how the scene becomes a model
+// Running a scene file as fast as possible (`sflsh simulate scene.yaml`):
+// a SceneSession (scene_session.hpp: how the scene becomes a model
 // and what its bodies, objects and tools do) stepped to its end, every
 // output frame recorded, and the contact and tool figures gathered. The
 // result holds every body's skin (concatenated,

@@ -1,5 +1,5 @@
 #pragma once
-// A scene advanced one step at a time (issue 11): the SceneDescription
+// A scene advanced one step at a time: the SceneDescription
 // (scene_description.hpp) becomes a Model — bodies with their soft-tissue and
 // skeleton terms, dynamic rigid objects as 6-DoF bodies, tools, and only the
 // contact terms the scene's pairs need — and a State, stepped with StepInputs

@@ -43,7 +43,7 @@ struct RunOptions {
   long inject_nan_at_step = 0;
 };
 
-/// A rigid object of a scene as results show it (issue 10): its surface in
+/// A rigid object of a scene as results show it: its surface in
 /// its own frame and its pose per output frame.
 struct ObjectTrack {
   std::string name;

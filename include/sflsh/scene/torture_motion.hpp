@@ -1,5 +1,5 @@
 #pragma once
-// A random-pose torture motion for stress runs (issue 13 §3): every `period`
+// A random-pose torture motion for stress runs: every `period`
 // seconds each limited joint's target jumps to a new random local rotation
 // inside its anatomical range (sim/joint_limits_table.hpp), so the skeleton is
 // yanked across its whole range of motion again and again. The root stays at

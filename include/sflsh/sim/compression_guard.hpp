@@ -1,5 +1,5 @@
 #pragma once
-// A per-sample volume guard for the mean-dilatation elastic term (issue 13).
+// A per-sample volume guard for the mean-dilatation elastic term.
 //
 // With mean dilatation (linearized_stiffness.hpp) the exact quadratic ½ zᵀ K z keeps only a
 // share α of each tet's own bulk stiffness; the rest is averaged over the tet's cell. The

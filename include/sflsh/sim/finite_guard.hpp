@@ -1,5 +1,5 @@
 #pragma once
-// The run-time numerical guard (issue 16): after a step, find the first
+// The run-time numerical guard: after a step, find the first
 // non-finite value in the state or the step's energies and name where it is
 // (the step, the energy term, the body), so that a run meeting NaN/Inf stops
 // with one clear error instead of writing NaN frames.

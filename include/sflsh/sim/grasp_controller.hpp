@@ -1,5 +1,5 @@
 #pragma once
-// The grasp step of a two-jaw gripper (AMBF Alg. 3; issue 11), pure logic:
+// The grasp step of a two-jaw gripper (AMBF Alg. 3), pure logic:
 // when the gripper's closure is below a threshold and one of the jaw's
 // proximity sensors hits the skin within its range, the hit faces' vertices
 // become anchors with their current offset in the jaw frame,

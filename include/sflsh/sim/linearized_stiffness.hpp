@@ -1,5 +1,5 @@
 #pragma once
-// The exact small-strain stiffness of the reduced model (issue 13):
+// The exact small-strain stiffness of the reduced model:
 //   ½ zᵀ K z = Σ_t V_t ½ vec(∇u_t)ᵀ H_t vec(∇u_t),   ∇u_t = Σ_h z_h d_{t,h}ᵀ,
 // over every tet that moves, H_t = ∂²Ψ₂/∂F² of the tet's material and frame
 // (material.hpp, linearized_hessian), d_{t,h} = Σ_n W_{n,h} ∇N_n.

@@ -44,14 +44,14 @@ struct NewtonOptions {
   /// at the first one taken in full. A cap bounds how far one linearization is
   /// trusted; it must not also bound how far the bones get within a time step:
   /// with one iteration, a capped step left the pelvis up to 21 mm behind its
-  /// motion (CMU 02_04 at 2×, dt = 1/30) and the lag went unnoticed (issue 13).
+  /// motion (CMU 02_04 at 2×, dt = 1/30) and the lag went unnoticed.
   /// Steps that are not damped are untouched (bit-identical). 0 = off.
   int iterations_after_damping = 3;
   /// When the last planned iteration was taken in full but the energy fell by
   /// a share ρ of what the quadratic model predicted (½ δᵀHδ) with |ρ − 1|
   /// above this, one more iteration is taken (with the Armijo line search):
   /// the step went far enough into the nonlinear range that one
-  /// linearization misses (issue 13: a CMU run's foot strikes). ρ costs
+  /// linearization misses (a CMU run's foot strikes). ρ costs
   /// nothing, the trial energy is evaluated anyway. With bones prescribed,
   /// |ρ − 1| stays ≤ 0.046 on `jump` (where a second iteration changes
   /// nothing) and exceeds 0.05 on about a quarter of the steps of `shake` and

@@ -1,5 +1,5 @@
 #pragma once
-// Proximity sensors of a tool (AMBF Fig. 5; issue 11): rays mounted in a
+// Proximity sensors of a tool (AMBF Fig. 5): rays mounted in a
 // tool's frame (origin, direction, range) cast against the posed skin — the
 // triangles Avatar::surface_faces over the skin vertices at the current
 // configuration, world. The first hit within range gives the face, its

@@ -1,5 +1,5 @@
 #pragma once
-// Keeping a simulation in step with the wall clock (AMBF Eq. 1; issue 11):
+// Keeping a simulation in step with the wall clock (AMBF Eq. 1):
 // a fixed substep δt and, per frame, N substeps,
 //   N = min(⌈lag / δt⌉, N_max),   lag = wall time since start − simulated time − dropped,
 // so that the simulated time follows the wall clock to within one substep when

@@ -1,5 +1,5 @@
 #pragma once
-// The terms of a dynamic rigid object (issue 10): a body of the model without
+// The terms of a dynamic rigid object: a body of the model without
 // an avatar (model.hpp), one 6-DoF "bone" G mapping its frame — centred on its
 // centre of mass, along its principal or shape axes — to the world. Its
 // inertia is the bone-inertia term for a single rigid body,

@@ -32,7 +32,7 @@ struct SkeletonTermsOptions {
   ///    every joint's springs have the frequency they are given. An avatar
   ///    without an inertia cubature falls back to Segments.
   ///  - Segments: Winter's segment masses as thin rods (bone_bodies with the
-  ///    whole body mass), the rule before issue 13. It undercounts the flesh
+  ///    whole body mass), the earlier rule. It undercounts the flesh
   ///    on the leaves: on the default body the right hand carries 14.5× and
   ///    the head 54× the rod's inertia, so their 20 Hz tracking springs ran at
   ///    5.2 and 2.7 Hz, and `shake` (5 Hz) drove the right hand into ±0.8 rad

@@ -1,5 +1,5 @@
 #pragma once
-// A live device on its own thread (issue 11): a PoseStreamServer read by a
+// A live device on its own thread: a PoseStreamServer read by a
 // background thread that answers every accepted pose at once with the newest
 // feedback the simulation published, so force feedback runs at the device's
 // rate (up to 1 kHz) whatever the physics rate, and the physics loop never

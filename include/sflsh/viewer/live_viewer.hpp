@@ -1,8 +1,8 @@
 #pragma once
 // `sflsh run scene.yaml --serve`: a SceneSession shown and driven in the
 // browser. The page's tool poses become the first tool's device poses
-// (SceneSession::set_device_pose, the same interface as the device stream of
-// issue 11); pause, step, reset (SceneSession::reset) and the stiffness slider
+// (SceneSession::set_device_pose, the same interface as the device stream);
+// pause, step, reset (SceneSession::reset) and the stiffness slider
 // (SceneSession::set_stiffness_scale, every body) come from the page and are
 // applied between frames; frames go out at the display rate from run_live's
 // per-frame hook, never blocking the physics.

@@ -1,5 +1,5 @@
 #pragma once
-// Anchors: flesh points tied to points of a tool (AMBF Alg. 3/4; issue 11),
+// Anchors: flesh points tied to points of a tool (AMBF Alg. 3/4),
 // as a term of the backward-Euler objective instead of explicit forces, so a
 // stiff grasp stays stable. Flesh point p is embedded in its tet (a row of a
 // PosedPoints set: x_p(q) follows the bones and the soft DoFs z); it is tied

@@ -1,5 +1,5 @@
 #pragma once
-// Body ↔ body contact through bone capsules (seed §5; issue 10). Each avatar
+// Body ↔ body contact through bone capsules (seed §5). Each avatar
 // carries capsules on its bones (Avatar::capsules, unposed); posed by their
 // bone, two capsules a, b with signed gap d = |p_a − p_b| − r_a − r_b (p_a, p_b
 // the closest axis points, geometry/capsule_distance.hpp) get the penalty

@@ -1,6 +1,6 @@
 #pragma once
 // Rigid ↔ flesh contact through a signed distance field (seed §5; DESIGN.md
-// §4; issue 10). Samples of the body's skin, embedded in their tets so that
+// §4). Samples of the body's skin, embedded in their tets so that
 // their world position x_p(q) follows the bones and the soft DoFs z
 // (posed_points.hpp), are pushed out of a rigid object's field φ by a
 // quadratic penalty on penetration:

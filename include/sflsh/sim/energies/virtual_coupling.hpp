@@ -1,5 +1,5 @@
 #pragma once
-// Virtual coupling (issue 11; AMBF and haptic rendering): a tool that is a
+// Virtual coupling (AMBF and haptic rendering): a tool that is a
 // dynamic rigid body of the model (rigid_body_terms.hpp) is pulled towards
 // its device's pose by a spring and a damper, as a term of the backward-Euler
 // objective, so a stiff coupling stays stable and the tool cannot be pushed
