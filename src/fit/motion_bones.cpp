@@ -2,6 +2,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/scene/simulation_run.hpp"
+#include "sflsh/sim/skeleton_pose.hpp"
 
 namespace sflsh {
 
@@ -15,8 +16,7 @@ BoneSequence motion_bones(const Avatar& avatar, const MotionClip& motion, double
   } else {
     // As run_simulation: q_{-1} = Δ⁻¹ q_0 with Δ = G(h) G(0)⁻¹ per bone.
     const std::vector<Isometry> next = target_bones(avatar, motion.sample(h));
-    for (size_t j = 0; j < next.size(); ++j)
-      seq.bones_before.push_back(seq.bones[0][j] * next[j].inverse() * seq.bones[0][j]);
+    seq.bones_before = bones_one_step_before(seq.bones[0], next);
   }
   return seq;
 }

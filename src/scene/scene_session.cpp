@@ -27,6 +27,7 @@
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sflsh/teleop/pose_file.hpp"
 #include "sflsh/teleop/pose_recorder.hpp"
+#include "sflsh/sim/skeleton_pose.hpp"
 #include "sflsh/teleop/pose_ramp.hpp"
 #include "sflsh/teleop/pose_stream_link.hpp"
 #include "sflsh/teleop/pose_track.hpp"
@@ -107,11 +108,11 @@ BodyState initial_state(const SceneBody& b, double h) {
   s.q.bones = target_bones(*b.avatar, placed_pose(b, 0.0));
   s.q.z = VecX::Zero(b.avatar->num_reduced());
   s.q_prev.z = s.q.z;
-  const std::vector<Isometry> next = target_bones(*b.avatar, placed_pose(b, h));
-  for (size_t j = 0; j < s.q.bones.size(); ++j) {
-    Isometry prev = b.has_motion ? Isometry(s.q.bones[j] * next[j].inverse() * s.q.bones[j]) : s.q.bones[j];
-    if (!b.has_motion) prev.translation() -= b.desc->velocity * h;
-    s.q_prev.bones.push_back(prev);
+  if (b.has_motion) {
+    s.q_prev.bones = bones_one_step_before(s.q.bones, target_bones(*b.avatar, placed_pose(b, h)));
+  } else {
+    s.q_prev.bones = s.q.bones;
+    for (Isometry& prev : s.q_prev.bones) prev.translation() -= b.desc->velocity * h;
   }
   return s;
 }

@@ -118,7 +118,7 @@ SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const Moti
     q0.bones = targets;
     q0.z = VecX::Zero(avatar->num_reduced());
     q_prev.z = q0.z;
-    for (size_t j = 0; j < targets.size(); ++j) q_prev.bones.push_back(targets[j] * next[j].inverse() * targets[j]);
+    q_prev.bones = bones_one_step_before(targets, next);
     sim.reset(q0, q_prev);
   }
 

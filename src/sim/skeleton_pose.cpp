@@ -54,4 +54,14 @@ Points joint_world_positions(const std::vector<Isometry>& bones, const Points& j
   return x;
 }
 
+std::vector<Isometry> bones_one_step_before(const std::vector<Isometry>& at_start,
+                                            const std::vector<Isometry>& after_one_step) {
+  require(at_start.size() == after_one_step.size(), "bones_one_step_before: ", at_start.size(), " bones at the start, ",
+          after_one_step.size(), " one step later");
+  std::vector<Isometry> before;
+  before.reserve(at_start.size());
+  for (size_t j = 0; j < at_start.size(); ++j) before.push_back(at_start[j] * after_one_step[j].inverse() * at_start[j]);
+  return before;
+}
+
 }  // namespace sflsh

@@ -53,5 +53,27 @@ TEST(SkeletonPose, RejectsMismatchedSkeleton) {
   EXPECT_THROW(joint_world_positions(G, a.joints_rest), Error);
 }
 
+TEST(SkeletonPose, BonesOneStepBeforeContinueTheFirstStepsMotionBackwards) {
+  // A bone moving 0.1 m along x and turning 0.3 rad about z (about the world
+  // origin) over the first step was, one step earlier, 0.1 m the other way and
+  // turned −0.3 rad: G(0) G(h)⁻¹ G(0) with G(0) = I. From G(0) = a turn of 0.2
+  // rad about z and G(h) = a turn of 0.5 rad: one step before, 0.2 − 0.3 = −0.1 rad.
+  auto turn = [](double angle, const Vec3& t) {
+    Isometry G = Isometry::Identity();
+    G.linear() = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+    G.translation() = t;
+    return G;
+  };
+  const std::vector<Isometry> at0{Isometry::Identity(), turn(0.2, Vec3::Zero())};
+  const std::vector<Isometry> at1{turn(0.3, Vec3(0.1, 0, 0)), turn(0.5, Vec3::Zero())};
+  const std::vector<Isometry> before = bones_one_step_before(at0, at1);
+  ASSERT_EQ(before.size(), 2u);
+  // Δ⁻¹ of (R_z(0.3), (0.1, 0, 0)) is (R_z(−0.3), −R_z(−0.3)(0.1, 0, 0)).
+  const Isometry expected0 = turn(-0.3, -(Eigen::AngleAxisd(-0.3, Vec3::UnitZ()) * Vec3(0.1, 0, 0)));
+  EXPECT_LT((before[0].matrix() - expected0.matrix()).norm(), 1e-15);
+  EXPECT_LT((before[1].matrix() - turn(-0.1, Vec3::Zero()).matrix()).norm(), 1e-15);
+  EXPECT_THROW(bones_one_step_before(at0, {at1[0]}), Error);
+}
+
 }  // namespace
 }  // namespace sflsh

@@ -35,4 +35,12 @@ Mat3 local_rotation(const std::vector<Isometry>& bones, const std::vector<int>& 
 /// constraint makes the two agree).
 Points joint_world_positions(const std::vector<Isometry>& bones, const Points& joints_rest);
 
+/// Starting a run moving with a motion: the bones one step before its first
+/// frame, q_{−1} = Δ⁻¹ q_0 per bone with Δ = G(h) G(0)⁻¹ the first step's
+/// motion, i.e. G(0) G(h)⁻¹ G(0), so that (q_0 − q_{−1})/h is the motion's
+/// velocity (backward Euler's inertia then carries the body on). `at_start`:
+/// G(0); `after_one_step`: G(h); the same length (throws otherwise).
+std::vector<Isometry> bones_one_step_before(const std::vector<Isometry>& at_start,
+                                            const std::vector<Isometry>& after_one_step);
+
 }  // namespace sflsh
