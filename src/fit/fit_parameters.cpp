@@ -116,9 +116,8 @@ std::vector<RegionMaterial> FitParameters::materials(const std::vector<RegionMat
     RegionMaterial& r = m.at(e.region);
     const RegionMaterial& b = base.at(e.region);
     if (e.kind == FitParameter::Kind::Young) {
-      r.young_along = b.young_along * std::exp(p[i]);
-      r.young_through = b.young_through * std::exp(p[i]);
-      r.young_around = b.young_around * std::exp(p[i]);
+      r.young_along = b.young_along, r.young_through = b.young_through, r.young_around = b.young_around;
+      r.scale_young(std::exp(p[i]));  // the base's moduli times e^p
     } else if (e.kind == FitParameter::Kind::FungC) {
       r.fung_c = b.fung_c * std::exp(p[i]);
     } else {

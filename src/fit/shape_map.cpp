@@ -251,8 +251,7 @@ std::vector<RegionMaterial> shape_map_materials(const ShapeMap& map, const Avata
     auto it = std::find_if(m.begin(), m.end(), [&](const RegionMaterial& r) { return r.name == region; });
     require(it != m.end(), "shape map: region '", region, "' of '", label, "' is not one of the avatar's");
     if (kind == "young") {
-      const double f = std::exp(p[i]);
-      it->young_along *= f, it->young_through *= f, it->young_around *= f;
+      it->scale_young(std::exp(p[i]));
     } else if (kind == "fung_c") {
       it->fung_c *= std::exp(p[i]);
     } else if (kind == "poisson") {

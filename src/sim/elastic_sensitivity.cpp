@@ -37,13 +37,7 @@ void add_sample_gradient(const Vec9& v, const int* handle, const Vec3* d, int m,
 RegionMaterial perturbed_material(const RegionMaterial& m, MaterialParameter kind, double step) {
   RegionMaterial r = m;
   switch (kind) {
-    case MaterialParameter::LogYoung: {
-      const double f = std::exp(step);
-      r.young_along *= f;
-      r.young_through *= f;
-      r.young_around *= f;
-      break;
-    }
+    case MaterialParameter::LogYoung: r.scale_young(std::exp(step)); break;
     case MaterialParameter::LogFungC: r.fung_c *= std::exp(step); break;
     case MaterialParameter::Poisson: r.poisson += step; break;
   }

@@ -50,6 +50,14 @@ struct RegionMaterial {
   double poisson = 0.45;
   double fung_c = 2e3;         ///< Pa, saturation scale of exp(2Ψ/c)
   double density = 1000.0;     ///< kg/m^3
+
+  /// Multiplies the three Young's moduli by `factor` (Poisson's ratio, Fung c and
+  /// density kept): the stiffness of the region times `factor`.
+  void scale_young(double factor) {
+    young_along *= factor;
+    young_through *= factor;
+    young_around *= factor;
+  }
 };
 
 struct Avatar {
