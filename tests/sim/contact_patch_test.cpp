@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
@@ -107,6 +108,7 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
   o.spacing = 0.003;
   o.patch_radius = 0.015;
   o.inner_tolerance = 1e-13;
+  o.subspace_mean_dilatation = false;  // as the elastic term of the Hessian check below
   const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false, o);
   for (bool dynamic : {false, true}) {
     StepContext ctx = context(a, &frames, dynamic);
@@ -154,6 +156,57 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
   }
 }
 
+TEST(ContactPatch, WhatThePatchSubtractsIsWhatTheSubspaceHolds) {
+  // The patch subtracts each tet's share of the subspace's elastic energy.
+  // With mean dilatation the subspace holds only α = 0.2 of each tet's own
+  // bulk stiffness (and its cubature a few tets' remainder); subtracting the
+  // exact energy of the tets instead leaves volume changes inside the patch
+  // with a negative stiffness: the step's Hessian is indefinite by about the
+  // bulk modulus and a deep press runs away. Here the step's Hessian (the
+  // term, the mean-dilatation elastic term and the inertia) at a strained
+  // state is positive semi-definite, on a cubature that holds every tet and
+  // on one that holds every third tet (three times the weight).
+  Avatar a = slab(6);
+  for (int every : {1, 3}) {
+    Avatar b = a;
+    Cubature cub;
+    std::vector<int> tets;
+    for (int t = 0; t < b.tet.num_elements(); t += every) tets.push_back(t);
+    cub.elements = Eigen::Map<const VecXi>(tets.data(), int(tets.size()));
+    cub.barycentric = MatXr::Constant(int(cub.elements.size()), 4, 0.25);
+    const VecX volume = fem::tet_volumes(b.tet);
+    cub.weights = VecX(int(cub.elements.size()));
+    for (int k = 0; k < cub.size(); ++k) cub.weights[k] = every * volume[cub.elements[k]];
+    b.elastic = cub;
+    std::map<std::string, WorldFrame> frames;
+    frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - 0.001, -0.003);
+    ContactPatchOptions o;
+    o.pressure_stiffness = 2.0e7;
+    o.spacing = 0.003;
+    o.patch_radius = 0.015;
+    const ContactPatchTerm term("ball", b, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false, o);
+    StepContext ctx = context(b, &frames, false);
+    Configuration q = ctx.q_prev;
+    for (int i = 0; i < q.z.size(); ++i) q.z[i] = 0.002 * std::sin(1.3 * i + 0.7);
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_FALSE(term.patch_nodes(ctx).empty());
+    const int n = ctx.layout.size();
+    MatX H = MatX::Zero(n, n);
+    term.evaluate(ctx, q, nullptr, &H);
+    const ElasticTerm elastic(b, true, true, true);
+    const InertiaTerm inertia(b);
+    for (const EnergyTerm* t : {static_cast<const EnergyTerm*>(&elastic), static_cast<const EnergyTerm*>(&inertia)}) {
+      StepContext tctx = ctx;
+      const auto tcache = begin_term_step(*t, tctx);
+      t->evaluate(tctx, q, nullptr, &H);
+    }
+    const Eigen::SelfAdjointEigenSolver<MatX> eig(0.5 * (H + H.transpose()));
+    EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-9 * eig.eigenvalues().maxCoeff())
+        << "cubature on every " << every << " tet(s): eigenvalues " << eig.eigenvalues().minCoeff() << " .. "
+        << eig.eigenvalues().maxCoeff();
+  }
+}
+
 /// Node displacement of a body after a step: W z at every node, plus the
 /// patch's δu from the term's report ("patch_displacement": node, δu).
 Points node_displacement(const Avatar& a, const VecX& z, const StepReport* rep) {
@@ -187,6 +240,7 @@ std::shared_ptr<const Model> pressed_model(const Avatar& a, bool patch, int iter
   so.mean_dilatation = false;  // every tet's own volume change, as the patch integrates it
   add_soft_tissue_terms(mb, body, so);
   ContactPatchOptions co;
+  co.subspace_mean_dilatation = so.mean_dilatation;
   co.pressure_stiffness = 2.0e7;
   co.spacing = 0.003;
   co.patch = patch;

@@ -11,7 +11,9 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/rotation.hpp"
 #include "sflsh/fem/tet_operators.hpp"
+#include "sflsh/sim/compression_guard.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/linearized_stiffness.hpp"
 
 namespace sflsh {
 
@@ -24,6 +26,7 @@ struct ContactPatchTerm::Evaluation {
   VecX gq;   // ∂Φ/∂q
   MatX Hqq;  // Gauss–Newton contact block
   MatX Hqp;  // cross block (layout rows by patch DoFs)
+  MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q derivatives)
   Vec3 force = Vec3::Zero();
   int active = 0;
   double depth = 0, area = 0;
@@ -129,6 +132,14 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     materials_.emplace_back(m, tet_frame(a, t));
     for (int c = 0; c < 4; ++c) node_mass_[a.tet.elements(t, c)] += m.density * tet_volume_[t] / 4.0;
   }
+  // What the subspace's elastic term holds of each tet (subspace_density).
+  if (o.subspace_mean_dilatation) dilatation_cell_ = dilatation_cells(a);
+  cubature_weight_ = VecX::Zero(T);
+  for (int k = 0; k < a.elastic.size(); ++k) {
+    const int t = a.elastic.elements[k];
+    require(t >= 0 && t < T, what, ": elastic cubature sample ", k, " has tet ", t, ", expected in [0, ", T, ")");
+    cubature_weight_[t] += a.elastic.weights[k];
+  }
   // Broad phase: vertices by dominant bone and 10 cm cell (unposed), each
   // cluster with a bounding radius and 5 cm of slack for skinning blends and
   // soft displacement (as sdf_contact.hpp's clusters).
@@ -152,6 +163,45 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   vertex_faces_.assign(a.surface_rest.rows(), {});
   for (int f = 0; f < a.surface_faces.rows(); ++f)
     for (int i = 0; i < 3; ++i) vertex_faces_[a.surface_faces(f, i)].push_back(f);
+}
+
+double ContactPatchTerm::subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
+  const MaterialPoint& m = materials_[t];
+  Mat9 Hq = H2;
+  if (dilatation_cell_.size() > 0 && dilatation_cell_[t] >= 0) {
+    // The tet's own share of the mean-dilatation quadratic (linearized_stiffness.cpp):
+    // α H₂ + (1 − α) P H₂ P, P = I − v vᵀ/3 the deviatoric projector (v = vec I);
+    // the cell's mean stays in the subspace. P H₂ P = H₂ − u vᵀ − v uᵀ + (vᵀH₂v/9) v vᵀ, u = H₂v/3.
+    Vec9 v = Vec9::Zero();
+    v[0] = v[4] = v[8] = 1.0;
+    const Vec9 u = H2 * v / 3.0;
+    const double b = v.dot(u) / 3.0;
+    Hq.noalias() -= (1.0 - kPerTetVolumeShare) * (u * v.transpose() + v * u.transpose() - b * v * v.transpose());
+  }
+  const Mat3 D = F - Mat3::Identity();
+  const Vec9 h = Eigen::Map<const Vec9>(D.data());
+  const Vec9 Hqh = Hq * h;
+  double psi = 0.5 * h.dot(Hqh);
+  if (P) *P = Eigen::Map<const Mat3>(Hqh.data());
+  if (H) *H = Hq;
+  // The cubature's remainder Ψ − Ψ₂ (and the compression guard), weighted as the samples in the tet.
+  const double c = cubature_weight_[t] / tet_volume_[t];
+  if (c == 0.0) return psi;
+  Mat3 Pr;
+  Mat9 Hr;
+  const Vec9 H2h = H2 * h;
+  double r = strain_energy_density(F, m, P ? &Pr : nullptr, H ? &Hr : nullptr, true) - 0.5 * h.dot(H2h);
+  if (P) Pr -= Eigen::Map<const Mat3>(H2h.data());
+  if (H) Hr -= H2;
+  if (options_.subspace_mean_dilatation)
+    r += compression_guard(F, (1.0 - kPerTetVolumeShare) * m.kappa, kCompressionGuardOnset, P ? &Pr : nullptr,
+                           H ? &Hr : nullptr, true);
+  if (P) *P += c * Pr;
+  // The Hessian serves the cross block Φ_zp only (evaluate_patch): a sample
+  // standing for many tets' volume (c ≫ 1) holds its remainder with that
+  // weight, but δu couples to z through this tet's own volume.
+  if (H) *H += std::min(c, 1.0) * Hr;
+  return psi + c * r;
 }
 
 int ContactPatchTerm::object_offset(const StepContext& ctx) const {
@@ -349,6 +399,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     out.gq = VecX::Zero(nq);
     out.Hqq = MatX::Zero(nq, nq);
     out.Hqp = MatX::Zero(nq, np);
+    out.K0pp = MatX::Zero(np, np);
   }
   double E = 0;
   Eigen::Matrix<double, 3, Eigen::Dynamic> J;
@@ -381,6 +432,17 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   }
 
   // Elasticity: the exact change δu brings to each patch tet.
+  // With mean dilatation the subspace holds only α of each tet's own bulk
+  // stiffness (subspace_density), so Φ_zz gains the rest, (1 − α) κ_t V_t
+  // (Wᵀ b_t)(Wᵀ b_t)ᵀ with b_t the tet's volume-change gradient (κ_t = vᵀH₂v/9,
+  // the rank-one bulk part of the material's small-strain Hessian): a PSD
+  // Gauss–Newton part of Φ_zz that the one Newton step needs (without it the
+  // step overshoots where the patch is). Collected as columns over the
+  // handles the patch's tets touch, then one rank update.
+  const bool bulk_hessian = q_derivatives && dilatation_cell_.size() > 0;
+  std::unordered_map<int, int> bulk_handle;  // handle → compressed index
+  std::vector<std::pair<int, Vec3>> bulk_entries;
+  std::vector<int> bulk_first{0};
   for (int t : c.tets) {
     std::array<int, 4> slot;
     Mat3 F0 = Mat3::Identity(), F1 = Mat3::Identity();
@@ -403,11 +465,11 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     if (!std::isfinite(psi1)) return out.energy = std::numeric_limits<double>::infinity();
     const double V = tet_volume_[t];
     E += V * psi1;
-    // The subspace's own energy of the tet: constant while δu varies (left out then).
-    Mat9 H0;
+    // What the subspace's elastic term holds of the tet: constant while δu varies (left out then).
+    Mat9 H0, H2;
+    if (mode.subspace_energy || q_derivatives) H2 = linearized_hessian(materials_[t]);
     if (mode.subspace_energy || q_derivatives)
-      E -= V * strain_energy_density(F0, materials_[t], q_derivatives ? &P0 : nullptr, q_derivatives ? &H0 : nullptr,
-                                     true);
+      E -= V * subspace_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_derivatives ? &H0 : nullptr);
     if (!p_derivatives) continue;
     // Element blocks K_kl (3x3) = V Σ_{b,l} ∇N_k[b] H(i + 3b, j + 3l) ∇N_l[l].
     auto element_blocks = [&](const Mat9& H) {
@@ -434,12 +496,30 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     // Only the Hessian is approximated: the gradient and the energy are exact.
     std::array<std::array<Mat3, 4>, 4> K0;
     if (q_derivatives) K0 = element_blocks(H0);
+    if (bulk_hessian && dilatation_cell_[t] >= 0) {
+      Vec9 v = Vec9::Zero();
+      v[0] = v[4] = v[8] = 1.0;
+      const double kappa = v.dot(H2 * v) / 9.0;
+      const double scale = std::sqrt((1.0 - kPerTetVolumeShare) * kappa * V);
+      for (int k = 0; k < 4; ++k) {
+        const int n = a.tet.elements(t, k);
+        if (!simulated(n)) continue;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
+          const int h = bulk_handle.try_emplace(int(it.col()), int(bulk_handle.size())).first->second;
+          bulk_entries.emplace_back(h, scale * it.value() * grads_[t].row(k).transpose());
+        }
+      }
+      bulk_first.push_back(int(bulk_entries.size()));
+    }
     for (int k = 0; k < 4; ++k) {
       const Vec3 gk = grads_[t].row(k).transpose();
       if (slot[k] >= 0) {
         out.gp.segment<3>(3 * slot[k]) += V * (P1 * gk);
         for (int l = 0; l < 4; ++l)
-          if (slot[l] >= 0) out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
+          if (slot[l] >= 0) {
+            out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
+            if (q_derivatives) out.K0pp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K0[k][l];
+          }
       }
       if (!q_derivatives) continue;
       const int n = a.tet.elements(t, k);
@@ -452,6 +532,22 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
           if (slot[l] >= 0) out.Hqp.block<3, 3>(row, 3 * slot[l]) += it.value() * K0[k][l];
       }
     }
+  }
+
+  if (bulk_hessian && !bulk_handle.empty()) {
+    MatX C = MatX::Zero(3 * long(bulk_handle.size()), long(bulk_first.size()) - 1);
+    for (size_t e = 0; e + 1 < bulk_first.size(); ++e)
+      for (int i = bulk_first[e]; i < bulk_first[e + 1]; ++i)
+        C.block<3, 1>(3 * bulk_entries[size_t(i)].first, long(e)) += bulk_entries[size_t(i)].second;
+    MatX G = MatX::Zero(C.rows(), C.rows());
+    G.selfadjointView<Eigen::Lower>().rankUpdate(C);
+    for (const auto& [ha, ia] : bulk_handle)
+      for (const auto& [hb, ib] : bulk_handle)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            const int r = 3 * ia + i, s = 3 * ib + j;
+            out.Hqq(z0 + 3 * ha + i, z0 + 3 * hb + j) += r >= s ? G(r, s) : G(s, r);
+          }
   }
 
   // Contact over the candidate faces' samples.
@@ -682,12 +778,27 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   Eigen::LLT<MatX>& llt = c.Hpp_llt;
   llt.compute(ev.Hpp);
   require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+  // The complement must stay below what the other terms carry for these DoFs
+  // (Wᵀ K0 W over the patch tets, the nodes' inertia, the contact): by the
+  // element-wise block argument it does when Φ_pp ⪰ K0_pp + M + C, i.e. when
+  // the dented state is at least as stiff as the subspace's own (K1 ⪰ K0 over
+  // the patch DoFs). When the patch relaxes a strained subspace state, K1 ≪ K0
+  // and the complement can exceed the whole step's Hessian many times (no
+  // diagonal shift makes it positive definite): Φ_pp + K0_pp is used instead,
+  // which is ⪰ K0_pp + M + C because K1 is PSD-projected. Only the Hessian
+  // changes; in the first case it is as before.
+  Eigen::LLT<MatX> below(ev.Hpp - ev.K0pp + MatX::Identity(ev.Hpp.rows(), ev.Hpp.cols()) *
+                                                (1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff()));
+  const bool relaxed = below.info() != Eigen::Success;
+  Eigen::LLT<MatX> guarded;
+  if (relaxed) guarded.compute(ev.Hpp + ev.K0pp);
+  require(!relaxed || guarded.info() == Eigen::Success, name(), ": the patch's guarded Hessian is not positive definite");
   const DofLayout& L = local_layout(ctx);
   c.linearized = true;
   c.z_lin = q.z;
   c.du_lin = du;
   c.Hpz = ev.Hqp.middleRows(L.z_offset(), L.num_reduced).transpose();
-  const MatX X = llt.matrixL().solve(Hc);
+  const MatX X = (relaxed ? guarded : llt).matrixL().solve(Hc);
   const MatX S = X.transpose() * X;
   for (size_t k = 0; k < rows.size(); ++k)
     for (size_t l = 0; l < rows.size(); ++l) (*hess)(rows[k], rows[l]) -= S(int(k), int(l));

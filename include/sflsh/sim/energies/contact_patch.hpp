@@ -10,7 +10,7 @@
 // object get their own displacement δu on top of the subspace,
 //   u_n = W_n z + δu_n   (unposed, m),   δu = 0 outside the patch,
 // and the step's energy gains the exact change that δu brings:
-//   Φ(q, δu) = Σ_{t ∈ patch tets} V_t [Ψ(F_t(Wz + δu)) − Ψ(F_t(Wz))]            (elasticity)
+//   Φ(q, δu) = Σ_{t ∈ patch tets} V_t [Ψ(F_t(Wz + δu)) − Ψ_t^sub(F_t(Wz))]       (elasticity)
 //            + Σ_{n ∈ patch} m_n/(2h²) (|r_n + e_n|² − |r_n|²) − m_n g·d_n           (inertia, gravity)
 //            + Σ_s ½ κ a_s min(φ(x_s), 0)²                                          (contact)
 // with d_n = A_n δu_n the node's world offset (A_n = Σ_j w_nj R_j), r_n = x_n(q)
@@ -20,6 +20,20 @@
 // vertices v_i embedded in their tets (surface_tet, surface_bary). Without δu
 // every term but the contact vanishes: the patch only refines.
 //
+// What the patch subtracts: Ψ_t^sub is what the body's elastic term holds of
+// tet t (elastic.hpp): the exact small-strain quadratic, with mean dilatation
+// only its own share of it (α H₂ + (1 − α) P H₂ P, the rest averaged over the
+// tet's cell and left in the subspace), plus the cubature's remainder Ψ − Ψ₂
+// (and compression guard) weighted by the samples in t (c_t = Σ w_s / V_t,
+// zero for most tets). Subtracting the tet's exact Ψ instead, as if the
+// subspace held it, gives local volume changes inside a patch a negative
+// stiffness of about the bulk modulus (the subspace holds α = 0.2 of it): a
+// 2 cm probe pressed 2 cm into the belly ran away within a second (the step's
+// Hessian indefinite beyond any diagonal shift). With Ψ_t^sub the z-energy
+// inside a patch is what the subspace keeps (cell means, other samples) plus
+// the relaxed exact energy, bounded below; in the limit (exact cubature, no
+// mean dilatation) Ψ_t^sub = Ψ.
+//
 // Condensation (Teng et al. 2015, "Subspace condensation"): the term's energy
 // is E(q) = min_δu Φ(q, δu), the patch minimized out at every evaluation
 // (Newton on δu with q fixed: a small dense system, a few iterations). Then
@@ -27,9 +41,12 @@
 // Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq, so the global step stays one
 // Newton step over bones and handles. Approximations, all in the Hessian
 // only: Gauss–Newton for the contact, the element Hessians PSD-projected, the
-// change of the subspace's own elastic Hessian in the patch (K(Wz + δu) −
-// K(Wz), zero for a quadratic energy) left out, and A_n held at the iterate's
-// bones (δu's rotation with the bones is not differentiated).
+// change of the elastic Hessian in the patch (K(Wz + δu) − K^sub(Wz)) reduced
+// to its small-strain part (the bulk share mean dilatation leaves out, rank
+// one per tet), the cross block Φ_zp taken at the subspace's state (Wᵀ K^sub)
+// with a guard that keeps the complement below what the subspace holds
+// (compute), and A_n held at the iterate's bones (δu's rotation with the
+// bones is not differentiated).
 //
 // Limit: with the patch covering every Simulated node, the elastic cubature
 // exact per tet and the inertia lumped at the nodes, E(q) is the full FEM's
@@ -77,6 +94,10 @@ struct ContactPatchOptions {
   double inner_tolerance = 1e-9;
   double release_displacement = 1e-6;  ///< m: a node leaves the patch once |δu| is below this
   int max_handles = 8;                 ///< basis row truncation of the skin vertices (sdf_contact.hpp)
+  /// The body's elastic term averages the volume change per cell
+  /// (SoftTissueOptions::mean_dilatation): the patch subtracts what that term
+  /// holds of each tet, so it must know (header comment, "What the patch subtracts").
+  bool subspace_mean_dilatation = true;  // SoftTissueOptions' default
 };
 
 class ContactPatchTerm : public EnergyTerm {
@@ -117,6 +138,11 @@ class ContactPatchTerm : public EnergyTerm {
                         Evaluation& out) const;
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
+  /// What the subspace's elastic term holds of tet `t` per unit volume at F
+  /// (J/m³; H2 the tet's small-strain Hessian), with its stress P; H
+  /// (PSD-projected) is the stiffness the cross block Φ_zp takes for the tet
+  /// (the remainder's weight capped at the tet's own volume).
+  double subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
   /// The dynamic object's 6 DoFs in the term's local system, or −1.
   int object_offset(const StepContext& ctx) const;
 
@@ -131,6 +157,8 @@ class ContactPatchTerm : public EnergyTerm {
   VecX node_mass_;        // lumped, kg
   std::vector<Eigen::Matrix<double, 4, 3>> grads_;  // per tet shape gradients
   VecX tet_volume_;
+  VecXi dilatation_cell_;  // per tet (mean dilatation), else empty
+  VecX cubature_weight_;   // per tet: the elastic cubature's weights in it (m³)
   std::vector<MaterialPoint> materials_;
   std::vector<std::vector<int>> node_tets_;    // tets of each node
   std::vector<std::vector<int>> vertex_faces_;  // skin faces of each vertex
