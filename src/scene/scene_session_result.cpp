@@ -1,5 +1,7 @@
 // What a SceneSession writes to a SimulationResult: the constant header (every
-// body's skin, the objects' and tools' surfaces) and one frame per call.
+// body's skin, the objects' and tools' surfaces, the tools' names) and one
+// frame per call (skins, joints, object poses, every tool's pose, closure,
+// force and torque, and the grasp and release events so far).
 #include "sflsh/scene/scene_session.hpp"
 
 #include "sflsh/sim/avatar_model.hpp"
@@ -57,6 +59,7 @@ SimulationResult SceneSession::result_header() const {
       r.objects.push_back({t.jaws[j].name, shape_type_name(t.desc->jaws[j].shape.type),
                            t.coupled() ? "dynamic" : "kinematic", t.jaws[j].model.surface.vertices,
                            t.jaws[j].model.surface.faces, {}});
+  for (const CompiledTool& t : cs.tools) r.tools.push_back({t.desc->name, {}});
   return r;
 }
 
@@ -113,6 +116,11 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
     if (tool.tool().desc->has_shape) r.objects[next++].poses.push_back(tool.drawn_pose(t));
   for (const ToolDriver& tool : m.tools)
     for (const CompiledJaw& j : tool.tool().jaws) r.objects[next++].poses.push_back(tool.jaw_pose(j));
+  for (size_t i = 0; i < m.tools.size(); ++i) {
+    const SceneToolState& ts = m.tools[i].state();
+    r.tools[i].frames.push_back({m.tools[i].drawn_pose(t), ts.device.closure, ts.force, ts.torque});
+  }
+  r.tool_events = m.events;
   ++r.num_frames;
 }
 

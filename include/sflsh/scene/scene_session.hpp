@@ -153,12 +153,15 @@ class SceneSession {
 
   /// The result's constant part: every body's skin concatenated (surface,
   /// faces, body names and offsets), the objects' and tools' surfaces
-  /// (objects first, then the tools with a shape), no frames.
+  /// (objects first, then the tools with a shape), every tool's name
+  /// (SimulationResult::tools), no frames.
   SimulationResult result_header() const;
   /// Current poses of the result_header() objects, in its order (world).
   std::vector<Isometry> object_poses() const;
   /// Appends the current state as a frame of `result` (made by result_header();
-  /// `step_ms`: the mean step time since the previous frame).
+  /// `step_ms`: the mean step time since the previous frame): skins, joints,
+  /// object poses, each tool's pose, closure, force and torque; and sets
+  /// result.tool_events to the events so far.
   void record_frame(SimulationResult& result, double step_ms) const;
 
   /// The simulator: the same object for the session's life (references stay

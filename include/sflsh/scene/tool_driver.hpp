@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sflsh/scene/scene_compiler.hpp"
+#include "sflsh/scene/simulation_run.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/step_report.hpp"
 #include "sflsh/teleop/pose_ramp.hpp"
@@ -46,12 +47,8 @@ struct SceneToolState {
   bool ramping_in = false;   ///< the tool is still being brought to the device (pose_stream.ramp_in)
 };
 
-/// A grasp or release (AMBF Alg. 3).
-struct SceneToolEvent {
-  double time = 0;
-  std::string tool, body, kind;  ///< kind: "grasp" | "release"
-  int points = 0;
-};
+/// A grasp or release (AMBF Alg. 3; simulation_run.hpp).
+using SceneToolEvent = ToolEvent;
 
 struct ToolDriverOptions {
   /// Print the stream's port to stderr when it opens.
