@@ -176,6 +176,7 @@ void run_scene_live(const RunArgs& a) {
     std::printf("wrote %s (tools per step) and %s (plot)\n", a.tool_log.c_str(), svg.c_str());
   }
   if (!a.out.empty()) {
+    result.tool_events = session.tool_events();  // also those after the last frame
     write_simulation_result(result, a.out);
     std::printf("wrote %s (%d frames%s)\n", a.out.c_str(), result.num_frames,
                 status.interrupted ? ", up to the signal" : stopped.empty() ? "" : ", marked incomplete");

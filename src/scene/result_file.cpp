@@ -28,6 +28,7 @@ std::string joined(const char* const (&list)[N]) {
 }
 
 std::string object_group(size_t o) { return "/objects/" + std::to_string(o); }
+std::string tool_group(size_t t) { return "/tools/" + std::to_string(t); }
 
 /// Checks that `scene` fits a skin of V vertices; `where` starts every message
 /// (the file path). The writer and the reader share it.
@@ -93,8 +94,9 @@ std::vector<Points> unstack(const std::vector<double>& flat, const std::vector<s
 }  // namespace
 
 ResultScene result_scene(const SimulationResult& r) {
-  ResultScene s{r.body_names, r.body_vertex_offsets, r.objects};
+  ResultScene s{r.body_names, r.body_vertex_offsets, r.objects, {}};
   for (ObjectTrack& t : s.objects) t.poses.clear();
+  for (const ToolTrack& t : r.tools) s.tool_names.push_back(t.name);
   return s;
 }
 
@@ -149,6 +151,8 @@ ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, cons
     f.write_matrix(g + "/faces", t.faces);
     object_names_.push_back(t.name);
   }
+  for (size_t t = 0; t < scene.tool_names.size(); ++t) f.write_string(tool_group(t) + "/name", scene.tool_names[t]);
+  tool_names_ = scene.tool_names;
   f.create_appendable("/frames/time", {});
   f.create_appendable("/frames/step_ms", {});
   f.create_appendable("/frames/positions", {V, 3}, true);
@@ -157,6 +161,12 @@ ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, cons
   f.create_appendable("/frames/reduced", {num_reduced});
   if (target_pelvis_) f.create_appendable("/frames/target_pelvis", {3});
   if (!object_names_.empty()) f.create_appendable("/frames/object_poses", {std::int64_t(object_names_.size()), 7});
+  if (const std::int64_t T = std::int64_t(tool_names_.size()); T > 0) {
+    f.create_appendable("/frames/tool_poses", {T, 7});
+    f.create_appendable("/frames/tool_closure", {T});
+    f.create_appendable("/frames/tool_force", {T, 3});
+    f.create_appendable("/frames/tool_torque", {T, 3});
+  }
 }
 
 ResultWriter::~ResultWriter() = default;
@@ -178,6 +188,8 @@ void ResultWriter::add_frame(const FrameData& fr) {
                                  {"reduced", fr.reduced.allFinite()}, {"target_pelvis", fr.target_pelvis.allFinite()},
                                  {"time", std::isfinite(fr.time)}})
     require(ok, at, ": ", name, " holds a non-finite value; not written");
+  require(fr.tools.size() == tool_names_.size(), at, ": ", fr.tools.size(), " tool frames for ", tool_names_.size(),
+          " tools");
   std::vector<double> poses(7 * object_names_.size());
   for (size_t o = 0; o < object_names_.size(); ++o)
     pose_to_row(fr.object_poses[o], &poses[7 * o], at + ": the pose of object '" + object_names_[o] + "'");
@@ -189,7 +201,49 @@ void ResultWriter::add_frame(const FrameData& fr) {
   f.append("/frames/reduced", fr.reduced.data());
   if (target_pelvis_) f.append("/frames/target_pelvis", fr.target_pelvis.data());
   if (!object_names_.empty()) f.append("/frames/object_poses", poses.data());
+  if (!tool_names_.empty()) append_tool_frames(fr.tools, at);
   ++frames_;
+}
+
+void ResultWriter::append_tool_frames(const std::vector<ToolFrame>& tools, const std::string& at) {
+  const size_t T = tools.size();
+  std::vector<double> poses(7 * T), closure(T), force(3 * T), torque(3 * T);
+  for (size_t t = 0; t < T; ++t) {
+    const ToolFrame& tf = tools[t];
+    const std::string what = at + ": tool '" + tool_names_[t] + "'";
+    pose_to_row(tf.pose, &poses[7 * t], what + ": its pose");
+    require(std::isfinite(tf.closure) && tf.force.allFinite() && tf.torque.allFinite(), what,
+            ": closure, force or torque holds a non-finite value; not written");
+    closure[t] = tf.closure;
+    std::copy(tf.force.data(), tf.force.data() + 3, &force[3 * t]);
+    std::copy(tf.torque.data(), tf.torque.data() + 3, &torque[3 * t]);
+  }
+  file_->append("/frames/tool_poses", poses.data());
+  file_->append("/frames/tool_closure", closure.data());
+  file_->append("/frames/tool_force", force.data());
+  file_->append("/frames/tool_torque", torque.data());
+}
+
+void ResultWriter::write_tool_events(const std::vector<ToolEvent>& events) {
+  if (events.empty()) return;
+  const std::int64_t E = std::int64_t(events.size());
+  std::vector<double> time;
+  std::vector<int> points;
+  std::vector<std::string> tool, body, kind;
+  for (const ToolEvent& e : events) {
+    require(e.kind == "grasp" || e.kind == "release", file_->path(), ": tool event kind '", e.kind,
+            "', expected grasp or release");
+    time.push_back(e.time);
+    points.push_back(e.points);
+    tool.push_back(e.tool);
+    body.push_back(e.body);
+    kind.push_back(e.kind);
+  }
+  file_->write_nd("/tool_events/time", time.data(), {E});
+  file_->write_nd("/tool_events/points", points.data(), {E});
+  file_->write_strings("/tool_events/tool", tool);
+  file_->write_strings("/tool_events/body", body);
+  file_->write_strings("/tool_events/kind", kind);
 }
 
 void ResultWriter::finish(const SimulationResult& r) {
@@ -210,6 +264,7 @@ void ResultWriter::finish(const SimulationResult& r) {
   f.write_nd("/steps/newton_decrement", r.step_decrement.data(), {S});
   f.write_nd("/steps/outcome", r.step_outcome.data(), {S});
   f.write_nd("/steps/ms", r.step_ms.data(), {S});
+  write_tool_events(r.tool_events);
   f.commit();
 }
 
@@ -220,6 +275,9 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
   for (const ObjectTrack& t : r.objects)
     require(t.poses.size() == r.frame_time.size(), path, ": object '", t.name, "' has ", t.poses.size(),
             " poses for ", r.frame_time.size(), " frames");
+  for (const ToolTrack& t : r.tools)
+    require(t.frames.size() == r.frame_time.size(), path, ": tool '", t.name, "' has ", t.frames.size(),
+            " frames for ", r.frame_time.size(), " frames");
   ResultWriter w(path, r.faces, r.surface_rest, nr, !r.frame_target_pelvis.empty(), result_scene(r));
   for (size_t i = 0; i < r.frame_time.size(); ++i) {
     FrameData fr;
@@ -231,10 +289,53 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
     fr.reduced = r.frame_reduced[i];
     if (!r.frame_target_pelvis.empty()) fr.target_pelvis = r.frame_target_pelvis[i];
     for (const ObjectTrack& t : r.objects) fr.object_poses.push_back(t.poses[i]);
+    for (const ToolTrack& t : r.tools) fr.tools.push_back(t.frames[i]);
     w.add_frame(fr);
   }
   w.finish(r);
 }
+
+namespace {
+
+/// Reads /tools, /frames/tool_* (F frames) and /tool_events into `r`, when the file has them.
+void read_tools(const io::Hdf5File& f, const std::string& path, std::int64_t F, SimulationResult& r) {
+  std::int64_t T = 0;
+  while (f.has(tool_group(size_t(T)))) ++T;
+  if (T > 0) {
+    const std::vector<double> poses = f.read_nd("/frames/tool_poses", {F, T, 7});
+    const std::vector<double> closure = f.read_nd("/frames/tool_closure", {F, T});
+    const std::vector<double> force = f.read_nd("/frames/tool_force", {F, T, 3});
+    const std::vector<double> torque = f.read_nd("/frames/tool_torque", {F, T, 3});
+    for (std::int64_t t = 0; t < T; ++t) {
+      ToolTrack track{f.read_string(tool_group(size_t(t)) + "/name"), {}};
+      for (std::int64_t i = 0; i < F; ++i) {
+        const size_t k = size_t(i * T + t);
+        ToolFrame tf;
+        tf.pose = pose_from_row(&poses[7 * k], path + ": dataset /frames/tool_poses, frame " + std::to_string(i) +
+                                                   ", tool " + std::to_string(t));
+        tf.closure = closure[k];
+        tf.force = Vec3(force[3 * k], force[3 * k + 1], force[3 * k + 2]);
+        tf.torque = Vec3(torque[3 * k], torque[3 * k + 1], torque[3 * k + 2]);
+        track.frames.push_back(tf);
+      }
+      r.tools.push_back(std::move(track));
+    }
+  } else {
+    require(!f.has("/frames/tool_poses"), path, ": dataset /frames/tool_poses given without /tools");
+  }
+  if (!f.has("/tool_events/time")) return;
+  const MatXr time = f.read_matrix("/tool_events/time", -1, 1);
+  const std::int64_t E = time.rows();
+  const auto points = f.read_int_matrix("/tool_events/points", E, 1);
+  const std::vector<std::string> tool = f.read_strings("/tool_events/tool"), body = f.read_strings("/tool_events/body"),
+                                 kind = f.read_strings("/tool_events/kind");
+  require(std::int64_t(tool.size()) == E && std::int64_t(body.size()) == E && std::int64_t(kind.size()) == E, path,
+          ": the /tool_events datasets differ in length (", E, " times)");
+  for (std::int64_t e = 0; e < E; ++e)
+    r.tool_events.push_back({time(e, 0), tool[size_t(e)], body[size_t(e)], kind[size_t(e)], points(e, 0)});
+}
+
+}  // namespace
 
 static SimulationResult read_simulation_result_in_this_process(const std::string& path) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
@@ -306,6 +407,7 @@ static SimulationResult read_simulation_result_in_this_process(const std::string
             &poses[size_t((i * O + o) * 7)], path + ": dataset /frames/object_poses, frame " + std::to_string(i) +
                                                  ", object " + std::to_string(o)));
   }
+  read_tools(f, path, F, r);
   MatXr red = f.read_matrix("/frames/reduced", F, -1);
   for (std::int64_t i = 0; i < F; ++i) r.frame_reduced.push_back(red.row(i).transpose());
   MatXr ms = f.read_matrix("/frames/step_ms", F, 1);

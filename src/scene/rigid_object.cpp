@@ -1,19 +1,13 @@
 #include "sflsh/scene/rigid_object.hpp"
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/rotation.hpp"
 #include "sflsh/geometry/grid_sdf.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/io/mesh_export.hpp"
 
 namespace sflsh {
 namespace {
-
-Isometry make_pose(const Vec3& p, const Eigen::Quaterniond& q) {
-  Isometry T = Isometry::Identity();
-  T.linear() = q.normalized().toRotationMatrix();
-  T.translation() = p;
-  return T;
-}
 
 /// Mass properties of a primitive by density, or scaled to the given mass.
 template <class Shape>
@@ -87,15 +81,30 @@ RigidObjectModel make_rigid_object(const RigidObjectDescription& o) {
 }
 
 Isometry object_pose_at(const RigidObjectDescription& o, double t) {
-  if (o.kind != ObjectKind::Kinematic || o.keyframes.empty()) return make_pose(o.position, o.orientation);
+  if (o.kind != ObjectKind::Kinematic || o.keyframes.empty()) return pose_at(o.position, o.orientation);
   const std::vector<Keyframe>& k = o.keyframes;
-  if (t <= k.front().time) return make_pose(k.front().position, k.front().orientation);
-  if (t >= k.back().time) return make_pose(k.back().position, k.back().orientation);
+  if (t <= k.front().time) return pose_at(k.front().position, k.front().orientation);
+  if (t >= k.back().time) return pose_at(k.back().position, k.back().orientation);
   size_t i = 1;
   while (k[i].time < t) ++i;
   const double a = (t - k[i - 1].time) / (k[i].time - k[i - 1].time);
-  return make_pose((1 - a) * k[i - 1].position + a * k[i].position,
+  return pose_at((1 - a) * k[i - 1].position + a * k[i].position,
                    k[i - 1].orientation.normalized().slerp(a, k[i].orientation.normalized()));
+}
+
+Isometry pose_at(const Vec3& position, const Eigen::Quaterniond& orientation) {
+  Isometry T = Isometry::Identity();
+  T.linear() = orientation.normalized().toRotationMatrix();
+  T.translation() = position;
+  return T;
+}
+
+WorldFrame frame_between(const Isometry& before, const Isometry& after, double h) {
+  WorldFrame f;
+  f.pose = after;
+  f.linear_velocity = (after.translation() - before.translation()) / h;
+  f.angular_velocity = rotation_log(after.linear() * before.linear().transpose()) / h;
+  return f;
 }
 
 }  // namespace sflsh

@@ -118,8 +118,8 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();
-  for (const SceneToolEvent& e : session.tool_events())
-    st.tool_events.push_back({e.time, e.tool, e.body, e.kind, e.points});
+  st.tool_events = session.tool_events();
+  r.tool_events = session.tool_events();  // also those after the last frame
   st.momentum_end = linear_momentum(sim.model(), sim.scene_state());
   if (stats) *stats = std::move(st);
   return r;

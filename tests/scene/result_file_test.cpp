@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "sflsh/core/error.hpp"
@@ -202,6 +203,63 @@ TEST(ResultFile, ScenesKeepBodiesObjectsAndPoses) {
   EXPECT_EQ(describe_scene_parts(small_result()), "");
 }
 
+TEST(ResultFile, ToolsKeepPosesClosuresForcesTorquesAndEvents) {
+  // Two tools, every value distinct and none a default: poses turning about
+  // different axes, closures, forces and torques changing per frame, and a
+  // grasp and a release.
+  test::TempDir tmp;
+  SimulationResult r = scene_result();
+  for (int t = 0; t < 2; ++t) {
+    ToolTrack track{t == 0 ? "gripper" : "probe", {}};
+    for (int f = 0; f < 3; ++f) {
+      ToolFrame tf;
+      tf.pose = pose(0.3 + 0.2 * f + t, Vec3(t, 1, 0.5), Vec3(0.1 * f, 1.05 - 0.01 * t, 0.118 + 0.003 * f));
+      tf.closure = 0.8 - 0.25 * f + 0.05 * t;
+      tf.force = Vec3(0.5 * f - t, 2.5 + f, -1.25 * (t + 1));
+      tf.torque = Vec3(0.01 * (f + 1), -0.02 * t, 0.003 * f + 0.007);
+      track.frames.push_back(tf);
+    }
+    r.tools.push_back(track);
+  }
+  r.tool_events = {{0.125, "gripper", "alice", "grasp", 7}, {0.2, "probe", "bob", "release", 3}};
+  write_simulation_result(r, tmp.file("t.h5"));
+  const SimulationResult b = read_simulation_result(tmp.file("t.h5"));
+  ASSERT_EQ(b.tools.size(), 2u);
+  for (size_t t = 0; t < 2; ++t) {
+    EXPECT_EQ(b.tools[t].name, r.tools[t].name);
+    ASSERT_EQ(b.tools[t].frames.size(), 3u);
+    for (size_t f = 0; f < 3; ++f) {
+      const ToolFrame &w = r.tools[t].frames[f], &g = b.tools[t].frames[f];
+      EXPECT_LT((g.pose.matrix() - w.pose.matrix()).norm(), 1e-14) << t << " " << f;
+      EXPECT_EQ(g.closure, w.closure);
+      EXPECT_EQ(g.force, w.force);
+      EXPECT_EQ(g.torque, w.torque);
+    }
+  }
+  ASSERT_EQ(b.tool_events.size(), 2u);
+  for (size_t e = 0; e < 2; ++e) {
+    EXPECT_EQ(b.tool_events[e].time, r.tool_events[e].time);
+    EXPECT_EQ(b.tool_events[e].tool, r.tool_events[e].tool);
+    EXPECT_EQ(b.tool_events[e].body, r.tool_events[e].body);
+    EXPECT_EQ(b.tool_events[e].kind, r.tool_events[e].kind);
+    EXPECT_EQ(b.tool_events[e].points, r.tool_events[e].points);
+  }
+  // The objects are unchanged by the tools next to them; a result without
+  // tools has none.
+  EXPECT_EQ(b.objects.size(), 2u);
+  write_simulation_result(scene_result(), tmp.file("none.h5"));
+  const SimulationResult n = read_simulation_result(tmp.file("none.h5"));
+  EXPECT_TRUE(n.tools.empty());
+  EXPECT_TRUE(n.tool_events.empty());
+  // A tool with a frame missing, or a non-finite force, is not written.
+  SimulationResult bad = r;
+  bad.tools[1].frames.pop_back();
+  test::expect_error([&] { write_simulation_result(bad, tmp.file("bad.h5")); }, {"tool 'probe'", "2 frames for 3"});
+  bad = r;
+  bad.tools[0].frames[1].force.y() = std::nan("");
+  test::expect_error([&] { write_simulation_result(bad, tmp.file("bad.h5")); }, {"frame 1", "tool 'gripper'", "non-finite"});
+}
+
 TEST(ResultFile, WriterRejectsScenesThatDoNotFit) {
   test::TempDir tmp;
   SimulationResult r = scene_result();
@@ -223,7 +281,7 @@ TEST(ResultFile, WriterRejectsScenesThatDoNotFit) {
   // Streaming: a frame without the object poses.
   r = scene_result();
   ResultWriter w(tmp.file("b.h5"), r.faces, r.surface_rest, 5, false, result_scene(r));
-  test::expect_error([&] { w.add_frame({0.0, 1.0, r.frame_positions[0], r.frame_displacement[0], r.frame_joints[0], r.frame_reduced[0], Vec3::Zero(), {}}); },
+  test::expect_error([&] { w.add_frame({0.0, 1.0, r.frame_positions[0], r.frame_displacement[0], r.frame_joints[0], r.frame_reduced[0], Vec3::Zero(), {}, {}}); },
                      {"frame 0", "0 object poses for 2 objects"});
 }
 

@@ -19,6 +19,7 @@
 
 #include "scene/box_avatar_fixture.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/result_file.hpp"
 #include "sflsh/scene/scene_session.hpp"
 #include "sflsh/teleop/stream_message.hpp"
 #include "test_support.hpp"
@@ -408,4 +409,58 @@ bodies:
   EXPECT_LT(object_force.y(), -0.1);  // the probe presses the body down
   EXPECT_EQ(tool.tool_state(0).force, -object_force);  // the body pushes the tool up by as much
   EXPECT_EQ(tool.body_surface(0), object.body_surface(0));  // the same dent
+}
+
+TEST_F(ToolSession, TheResultFileHoldsEveryToolsFramesAndItsGraspEvents) {
+  // A gripper closing 2 mm above the top grasps the skin; its frames in the
+  // result (pose, closure, force, torque) are what the session reported at
+  // each recorded step, and the grasp is among the file's events.
+  SceneSession s(read_scene_description(write_scene(R"(
+solver: {dt: 1/250, seconds: 0.3, gravity: [0, 0, 0]}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.032, 0.0], closure: 1.0}
+      - {time: 0.2, position: [0.0, 0.032, 0.0], closure: 0.0}
+      - {time: 0.3, position: [0.0, 0.036, 0.0], closure: 0.0}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.01}]
+      hardness: 2000
+)")),
+                 quiet());
+  SimulationResult r = s.result_header();
+  ASSERT_EQ(r.tools.size(), 1u);
+  EXPECT_EQ(r.tools[0].name, "gripper");
+  std::vector<SceneToolState> recorded;
+  while (s.steps_done() < s.total_steps()) {
+    s.advance();
+    if (s.steps_done() % 15 == 0) {
+      s.record_frame(r, 0.0);
+      recorded.push_back(s.tool_state(0));
+    }
+  }
+  ASSERT_FALSE(s.tool_events().empty());
+  const std::string path = (dir_ / "result.h5").string();
+  write_simulation_result(r, path);
+  const SimulationResult b = read_simulation_result(path);
+  ASSERT_EQ(b.tools.size(), 1u);
+  ASSERT_EQ(b.tools[0].frames.size(), recorded.size());
+  bool pulled = false;
+  for (size_t f = 0; f < recorded.size(); ++f) {
+    const ToolFrame& g = b.tools[0].frames[f];
+    EXPECT_LT((g.pose.matrix() - recorded[f].pose.matrix()).norm(), 1e-14) << f;
+    EXPECT_EQ(g.closure, recorded[f].device.closure) << f;
+    EXPECT_EQ(g.force, recorded[f].force) << f;
+    EXPECT_EQ(g.torque, recorded[f].torque) << f;
+    pulled = pulled || g.force.norm() > 0;
+  }
+  EXPECT_TRUE(pulled) << "the grasped skin pulls on the tool";
+  ASSERT_EQ(b.tool_events.size(), s.tool_events().size());
+  EXPECT_EQ(b.tool_events[0].tool, "gripper");
+  EXPECT_EQ(b.tool_events[0].body, "base");
+  EXPECT_EQ(b.tool_events[0].kind, "grasp");
+  EXPECT_EQ(b.tool_events[0].time, s.tool_events()[0].time);
+  EXPECT_GT(b.tool_events[0].points, 0);
 }

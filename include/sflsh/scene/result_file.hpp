@@ -39,6 +39,16 @@
 //                                      plane_patch_mesh), outward along the plane's normal;
 //                                      exports redraw it sized to the bodies
 //                                      (result_export.hpp)
+//   /tools/<t>/name       string, t = 0..T-1: the scene's tools (ToolTrack). Only when T > 0.
+//   /frames/tool_poses    (Fr,T,7)     tool t's pose (tool frame -> world) per frame, as
+//                                      /frames/object_poses
+//   /frames/tool_closure  (Fr,T)       its device's jaw opening, rad (0 = shut)
+//   /frames/tool_force    (Fr,T,3)     force the bodies exert on it (contact and anchors), N, world
+//   /frames/tool_torque   (Fr,T,3)     torque about its frame's origin, N·m, world
+//   /tool_events/{time (E,) s, tool (E,), body (E,), kind (E,) "grasp" | "release",
+//                points (E,) int}      grasps and releases; only when there were any
+//   (the /tools, /frames/tool_* and /tool_events datasets are absent in files
+//   written before they existed, and in results without tools)
 //   /steps/{time, energy, grad_norm, newton_decrement, outcome, ms}   (S,) per step
 //     outcome: 0 accepted, 1 damped, 2 rejected
 #include <memory>
@@ -57,9 +67,10 @@ struct ResultScene {
   std::vector<std::string> body_names;  ///< empty = one body
   std::vector<int> body_vertex_offsets; ///< #bodies + 1 entries, or empty with body_names
   std::vector<ObjectTrack> objects;     ///< name, shape, kind, vertices, faces (poses unused)
+  std::vector<std::string> tool_names;  ///< the tools (frames come with each frame)
 };
 
-/// The bodies and objects of `result` (objects copied without their poses).
+/// The bodies, objects and tools of `result` (objects copied without their poses).
 ResultScene result_scene(const SimulationResult& result);
 
 /// Number of bodies of a result: body_names.size(), or 1 when that is empty.
@@ -85,18 +96,25 @@ class ResultWriter {
                bool target_pelvis = true, const ResultScene& scene = {});
   ~ResultWriter();
   /// Appends a frame: positions and displacement #V by 3, joints 24·B by 3,
-  /// reduced of num_reduced, one finite rigid pose per object. Throws naming
+  /// reduced of num_reduced, one finite rigid pose per object, one finite
+  /// ToolFrame per tool. Throws naming
   /// the path and the field on a size mismatch or a non-finite/non-rigid pose.
   void add_frame(const FrameData& frame);
   void finish(const SimulationResult& result);
   int num_frames() const { return frames_; }
 
  private:
+  /// Appends one frame of every tool (/frames/tool_*); `at` starts messages.
+  void append_tool_frames(const std::vector<ToolFrame>& tools, const std::string& at);
+  /// /tool_events (nothing when there are none).
+  void write_tool_events(const std::vector<ToolEvent>& events);
+
   std::unique_ptr<io::Hdf5File> file_;
   int frames_ = 0;
   bool target_pelvis_ = true;
   Eigen::Index num_vertices_ = 0, num_joints_ = 24, num_reduced_ = 0;
   std::vector<std::string> object_names_;
+  std::vector<std::string> tool_names_;
 };
 
 /// Writes a whole result; /frames/target_pelvis only when the result has it,

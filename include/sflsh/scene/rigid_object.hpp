@@ -12,6 +12,7 @@
 #include "sflsh/geometry/sdf.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/sim/configuration.hpp"
+#include "sflsh/sim/energy_term.hpp"
 
 namespace sflsh {
 
@@ -34,5 +35,12 @@ RigidObjectModel make_rigid_object(const RigidObjectDescription& object);
 /// (positions linear, orientations slerped, held before the first and after
 /// the last keyframe).
 Isometry object_pose_at(const RigidObjectDescription& object, double t);
+
+/// The rigid transform at `position` (m) turned by `orientation` (normalized first).
+Isometry pose_at(const Vec3& position, const Eigen::Quaterniond& orientation);
+
+/// The world frame of a step that moves a frame from `before` to `after` over
+/// h seconds: the pose `after`, the twist by finite difference (world).
+WorldFrame frame_between(const Isometry& before, const Isometry& after, double h);
 
 }  // namespace sflsh

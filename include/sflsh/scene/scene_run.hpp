@@ -44,11 +44,7 @@ struct SceneContactStats {
   };
   std::vector<ToolStep> tool_steps;
   /// Grasp and release events.
-  struct ToolEvent {
-    double time = 0;
-    std::string tool, body, kind;  ///< kind: "grasp" | "release"
-    int points = 0;
-  };
+  using ToolEvent = sflsh::ToolEvent;
   std::vector<ToolEvent> tool_events;
   std::string describe() const;
   /// CSV: time, tool, force (N), anchors, max_stretch (m), one row per tool and step.

@@ -6,6 +6,11 @@
 // that carry each body's motion targets and the static and kinematic objects
 // and tools as named world frames.
 //
+// The session is a facade: compile_scene (scene_compiler.hpp) makes the Model,
+// the initial State and the bodies', objects' and tools' constant parts; one
+// ToolDriver per tool (tool_driver.hpp) runs its pose source, jaws, grasps and
+// feedback; the session steps them together.
+//
 // `sflsh simulate scene.yaml` (run_scene, scene_run.hpp) steps it as fast as
 // it can and records frames; `sflsh run scene.yaml --realtime` steps it in
 // time with the wall clock; the browser viewer pushes device poses into it.
@@ -36,6 +41,7 @@
 
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/simulation_run.hpp"
+#include "sflsh/scene/tool_driver.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/step_report.hpp"
 #include "sflsh/teleop/pose_sample.hpp"
@@ -59,33 +65,6 @@ struct SceneSessionOptions {
   /// hold instead of its own pose source (its stream is not opened). Replaying
   /// a recorded session gives bit-identical trajectories.
   std::string replay_dir;
-};
-
-/// A tool after the latest step.
-struct SceneToolState {
-  /// The device (pose source) sample the last step drove the tool to.
-  teleop::PoseSample device;
-  /// The tool's pose at the current time (world): the device's for a
-  /// kinematic tool, the coupled rigid body's with a coupling.
-  Isometry pose = Isometry::Identity();
-  /// Force (N) and torque (N·m, about the tool's frame origin) the bodies
-  /// exert on the tool through its contact and anchors (world).
-  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
-  /// What the device is sent: the coupling's force and torque on the device
-  /// (kinematic tool: force/torque above), times haptic_gain, the force
-  /// clamped to max_force (N, N·m, world).
-  Vec3 feedback_force = Vec3::Zero(), feedback_torque = Vec3::Zero();
-  int anchors = 0;           ///< flesh points anchored now
-  double max_stretch = 0;    ///< m, the largest anchor stretch |x_p − a_p|
-  bool live = false;         ///< the pose comes from a stream or set_device_pose()
-  bool ramping_in = false;   ///< the tool is still being brought to the device (pose_stream.ramp_in)
-};
-
-/// A grasp or release (AMBF Alg. 3).
-struct SceneToolEvent {
-  double time = 0;
-  std::string tool, body, kind;  ///< kind: "grasp" | "release"
-  int points = 0;
 };
 
 class SceneSession {
@@ -174,12 +153,15 @@ class SceneSession {
 
   /// The result's constant part: every body's skin concatenated (surface,
   /// faces, body names and offsets), the objects' and tools' surfaces
-  /// (objects first, then the tools with a shape), no frames.
+  /// (objects first, then the tools with a shape), every tool's name
+  /// (SimulationResult::tools), no frames.
   SimulationResult result_header() const;
   /// Current poses of the result_header() objects, in its order (world).
   std::vector<Isometry> object_poses() const;
   /// Appends the current state as a frame of `result` (made by result_header();
-  /// `step_ms`: the mean step time since the previous frame).
+  /// `step_ms`: the mean step time since the previous frame): skins, joints,
+  /// object poses, each tool's pose, closure, force and torque; and sets
+  /// result.tool_events to the events so far.
   void record_frame(SimulationResult& result, double step_ms) const;
 
   /// The simulator: the same object for the session's life (references stay

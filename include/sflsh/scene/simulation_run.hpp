@@ -54,6 +54,28 @@ struct ObjectTrack {
   std::vector<Isometry> poses;  ///< one per output frame: object frame → world
 };
 
+/// A tool of a scene at one output frame.
+struct ToolFrame {
+  Isometry pose = Isometry::Identity();  ///< tool frame → world (what is drawn)
+  double closure = 0;                    ///< jaw opening of its device (rad, 0 = shut)
+  /// Force (N) and torque (N·m, about the tool's frame origin) the bodies exert
+  /// on the tool through its contact and anchors (world; SceneToolState).
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+};
+
+/// A tool of a scene as results show it: one ToolFrame per output frame.
+struct ToolTrack {
+  std::string name;
+  std::vector<ToolFrame> frames;
+};
+
+/// A grasp or release by a tool (AMBF Alg. 3).
+struct ToolEvent {
+  double time = 0;               ///< s
+  std::string tool, body, kind;  ///< kind: "grasp" | "release"
+  int points = 0;                ///< skin points anchored or let go
+};
+
 /// One output frame (what the result file stores per frame).
 struct FrameData {
   double time = 0, step_ms = 0;
@@ -63,6 +85,7 @@ struct FrameData {
   VecX reduced;   ///< every body's z, concatenated
   Vec3 target_pelvis = Vec3::Zero();  ///< the motion's pelvis at `time` (world, m; first body)
   std::vector<Isometry> object_poses;  ///< one per SimulationResult::objects entry
+  std::vector<ToolFrame> tools;        ///< one per SimulationResult::tools entry
 };
 
 struct SimulationResult {
@@ -73,6 +96,10 @@ struct SimulationResult {
   std::vector<int> body_vertex_offsets;
   /// Rigid objects of the scene (poses per output frame); empty without objects.
   std::vector<ObjectTrack> objects;
+  /// Tools of the scene (a frame per output frame) and their grasp and release
+  /// events; empty without tools.
+  std::vector<ToolTrack> tools;
+  std::vector<ToolEvent> tool_events;
   double dt = 0;
   bool bones_dynamic = false;
   int newton_iters = 1;

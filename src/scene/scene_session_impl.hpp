@@ -1,0 +1,34 @@
+#pragma once
+// SceneSession's state, shared by its two source files: scene_session.cpp
+// (building, stepping, tools, stiffness) and scene_session_result.cpp (what
+// it writes to a result).
+#include <memory>
+#include <vector>
+
+#include "sflsh/scene/scene_compiler.hpp"
+#include "sflsh/scene/scene_session.hpp"
+#include "sflsh/scene/tool_driver.hpp"
+
+namespace sflsh {
+
+struct SceneSession::Impl {
+  SceneDescription sc;
+  SceneSessionOptions opt;
+  CompiledScene compiled;         ///< refers to `sc`
+  std::vector<ToolDriver> tools;  ///< one per compiled tool (refers to `compiled`)
+  std::unique_ptr<Simulator> sim;
+  StepInputs in;
+  StepReport report;
+  std::vector<SceneToolEvent> events;
+  State initial;               ///< the state at t = 0 with the tools started (reset)
+  std::vector<double> stiffness;  ///< per body (scene order): its stiffness scale
+  long k = 0;                  ///< steps done
+
+  /// An object's pose at time t: its description's, or its rigid body's (dynamic).
+  Isometry object_pose(const CompiledObject& o, double t) const {
+    if (o.model_index < 0) return object_pose_at(*o.desc, t);
+    return Isometry(sim->state(o.model_index).bones[0] * o.model.shape_in_body);
+  }
+};
+
+}  // namespace sflsh

@@ -1,0 +1,351 @@
+// Golden results of compiling the example scenes (apps/scenes/*.yaml and
+// apps/scenes/figures/*.yaml) into a session: the Model's term list (names,
+// order, bound bodies), its DoF layout, and the State after the first step and
+// after a few more, pinned bit for bit (a hash of every double of the state and
+// of the tools' states). A refactor of how a scene is built or stepped must
+// reproduce them exactly.
+//
+// Each scene is run on the small box avatar of box_avatar_fixture.hpp instead
+// of the built-in body (`avatar: default`), its body moved where the scene's
+// objects and tools meet the belly so that contact and grasping happen within
+// the steps taken; live streams stay closed.
+//
+// To re-record after an intended change of the physics (never for a refactor):
+//   SFLSH_PRINT_GOLDEN=1 build/test_scene --gtest_filter='SceneCompileGolden.*'
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include "scene/box_avatar_fixture.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_session.hpp"
+#include "test_support.hpp"
+
+using namespace sflsh;
+
+namespace {
+
+/// FNV-1a over the bytes of every value hashed: any change of a bit shows.
+class BitHash {
+ public:
+  void add(double x) { add_bytes(&x, sizeof x); }
+  void add(int x) { add_bytes(&x, sizeof x); }
+  void add(const Isometry& T) {
+    for (int i = 0; i < 16; ++i) add(T.matrix().data()[i]);
+  }
+  void add(const VecX& v) {
+    add(int(v.size()));
+    for (Eigen::Index i = 0; i < v.size(); ++i) add(v[i]);
+  }
+  void add(const Vec3& v) {
+    for (int i = 0; i < 3; ++i) add(v[i]);
+  }
+  void add(const Configuration& q) {
+    add(int(q.bones.size()));
+    for (const Isometry& G : q.bones) add(G);
+    add(q.z);
+  }
+  std::string hex() const {
+    char s[17];
+    std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(h_));
+    return s;
+  }
+
+ private:
+  void add_bytes(const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 1099511628211ull;
+  }
+  std::uint64_t h_ = 1469598103934665603ull;
+};
+
+/// The model's terms in order: "name@body,body" separated by "; ".
+std::string term_list(const Model& m) {
+  std::string s;
+  for (const Model::BoundTerm& t : m.terms()) {
+    s += (s.empty() ? "" : "; ") + t.term->name() + "@";
+    for (size_t i = 0; i < t.bodies.size(); ++i) s += (i ? "," : "") + std::to_string(t.bodies[i]);
+  }
+  return s;
+}
+
+/// The DoF layout: per body "name:dynamic/bones/reduced@base", then the total.
+std::string dof_layout(const Model& m) {
+  std::ostringstream s;
+  for (const Model::Body& b : m.bodies())
+    s << b.name << ":" << b.layout.bones_dynamic << "/" << b.layout.num_bones << "/" << b.layout.num_reduced << "@"
+      << b.layout.base << " ";
+  s << "dofs " << m.num_dofs() << " blocks " << m.blocks().size() << " groups " << m.groups().size();
+  return s.str();
+}
+
+std::string state_hash(const SceneSession& s) {
+  BitHash h;
+  const State& st = s.simulator().scene_state();
+  h.add(st.time);
+  for (const BodyState& b : st.bodies) {
+    h.add(b.q);
+    h.add(b.q_prev);
+  }
+  return h.hex();
+}
+
+std::string tools_hash(const SceneSession& s) {
+  BitHash h;
+  for (int i = 0; i < s.num_tools(); ++i) {
+    const SceneToolState& t = s.tool_state(i);
+    h.add(t.pose);
+    h.add(t.force);
+    h.add(t.torque);
+    h.add(t.feedback_force);
+    h.add(t.feedback_torque);
+    h.add(t.anchors);
+    h.add(t.max_stretch);
+    h.add(t.device.position);
+    h.add(t.device.closure);
+  }
+  for (const Isometry& T : s.object_poses()) h.add(T);
+  for (const SceneToolEvent& e : s.tool_events()) {
+    h.add(e.time);
+    h.add(e.points);
+  }
+  return h.hex();
+}
+
+struct Golden {
+  std::string terms, layout, first_step, last_step, tools;
+  int events = 0;
+};
+
+struct ExampleScene {
+  const char* file;  ///< under apps/scenes, or (starting with '\n') the scene's text
+
+  /// Moves the box avatar where the scene's objects and tools act.
+  std::function<void(SceneDescription&)> place;
+  long steps;
+  Golden golden;
+  /// Called after the first step (e.g. to change the stiffness scale).
+  std::function<void(SceneSession&)> after_first_step = nullptr;
+};
+
+/// The box's front face (z = +0.03 m in its frame) at z = 0.11 m with the
+/// height y = 1.05 m inside it: where the example scenes' belly is.
+void at_belly(SceneDescription& s) { s.bodies[0].offset = Vec3(0, 1.035, 0.08); }
+
+class SceneCompileGolden : public test::BoxAvatarScene {
+ protected:
+  void check(const ExampleScene& ex) {
+    const bool inline_text = ex.file[0] == '\n';
+    SceneDescription sc = read_scene_description(inline_text ? write_scene(ex.file)
+                                                             : test::source_dir() + "/apps/scenes/" + ex.file);
+    for (BodyDescription& b : sc.bodies) {
+      b.avatar = (dir_ / "box.h5").string();
+      b.default_avatar = false;
+    }
+    if (ex.place) ex.place(sc);
+    const std::string label = inline_text ? ::testing::UnitTest::GetInstance()->current_test_info()->name() : ex.file;
+    SceneSessionOptions o;
+    o.progress = false;
+    o.open_streams = false;
+    SceneSession s(sc, o);
+    Golden got;
+    got.terms = term_list(s.simulator().model());
+    got.layout = dof_layout(s.simulator().model());
+    s.advance();
+    got.first_step = state_hash(s);
+    if (ex.after_first_step) ex.after_first_step(s);
+    while (s.steps_done() < ex.steps) s.advance();
+    got.last_step = state_hash(s);
+    got.tools = tools_hash(s);
+    got.events = int(s.tool_events().size());
+    if (std::getenv("SFLSH_PRINT_GOLDEN")) {
+      std::printf("%s:\n  {\"%s\",\n   \"%s\",\n   \"%s\", \"%s\", \"%s\", %d}\n", label.c_str(), got.terms.c_str(),
+                  got.layout.c_str(), got.first_step.c_str(), got.last_step.c_str(), got.tools.c_str(), got.events);
+      return;
+    }
+    EXPECT_EQ(got.terms, ex.golden.terms) << label;
+    EXPECT_EQ(got.layout, ex.golden.layout) << label;
+    EXPECT_EQ(got.first_step, ex.golden.first_step) << label << ": the state after one step";
+    EXPECT_EQ(got.last_step, ex.golden.last_step) << label << ": the state after " << ex.steps << " steps";
+    EXPECT_EQ(got.tools, ex.golden.tools) << label << ": the tools' states";
+    EXPECT_EQ(got.events, ex.golden.events) << label << ": grasp and release events";
+  }
+};
+
+}  // namespace
+
+TEST_F(SceneCompileGolden, BallAtBelly) {
+  check({"ball_at_belly.yaml", at_belly, 20,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; bone_gravity@1; contact:ball@0,1",
+          "alice:0/24/18@0 ball:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "68ed6ec61abdbba7", "670879260910bff2", "378c71ae1c396701", 0}});
+}
+
+TEST_F(SceneCompileGolden, BoxPress) {
+  check({"box_press.yaml", at_belly, 90,
+         {"inertia@0; elastic@0; gravity@0; contact:press@0",
+          "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
+          "891bb8cfc4ef3cea", "d46f27e007440f57", "602916d977821fb4", 0}});
+}
+
+TEST_F(SceneCompileGolden, FallOnFloor) {
+  check({"fall_on_floor.yaml", nullptr, 25,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; contact:floor@0; self_contact@0",
+          "alice:1/24/18@0 dofs 162 blocks 25 groups 1",
+          "d15e96574e431472", "0dc3b3af81ecd280", "176d968e934f1089", 0}});
+}
+
+TEST_F(SceneCompileGolden, PinchBelly) {
+  check({"pinch_belly.yaml", at_belly, 40,
+         {"inertia@0; elastic@0; gravity@0; anchor:gripper@alice@0",
+          "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
+          "792ef903953b7ef5", "a44b4a48eea008cc", "616b08f3261f6977", 1}});
+}
+
+TEST_F(SceneCompileGolden, TeleopPinch) {
+  check({"teleop_pinch.yaml", at_belly, 5,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; coupling:gripper@1; anchor:gripper@alice@0,1",
+          "alice:0/24/18@0 gripper:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "475744638fd3888d", "29678b6fc97123f1", "fabcba68b78a16da", 0}});
+}
+
+TEST_F(SceneCompileGolden, TwoWalkers) {
+  auto closer = [](SceneDescription& s) {
+    s.bodies[0].offset.z() = -0.04;
+    s.bodies[1].offset.z() = 0.04;
+  };
+  check({"two_walkers.yaml", closer, 6,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; body_contact@0,1",
+          "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
+          "55315353cb598496", "2530ffe84ae7a5c3", "14650fb0739d0383", 0}});
+}
+
+TEST_F(SceneCompileGolden, MomentumBump) {
+  auto closer = [](SceneDescription& s) {
+    s.bodies[0].offset.z() = -0.04;
+    s.bodies[1].offset.z() = 0.04;
+  };
+  check({"figures/momentum_bump.yaml", closer, 6,
+         {"inertia@0; elastic@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; body_contact@0,1",
+          "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
+          "bb69675050e51204", "ba417960e2c32032", "14650fb0739d0383", 0}});
+}
+
+TEST_F(SceneCompileGolden, PinchCoupled) {
+  check({"figures/pinch_coupled.yaml", at_belly, 130,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; coupling:gripper@1; anchor:gripper@alice@0,1",
+          "alice:0/24/18@0 gripper:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "aea730fe525068cc", "8eeb242d76d659e9", "dec85dfb8506dbee", 1}});
+}
+
+TEST_F(SceneCompileGolden, PinchFromFile) {
+  check({"figures/pinch_from_file.yaml", at_belly, 40,
+         {"inertia@0; elastic@0; gravity@0; anchor:gripper@alice@0",
+          "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
+          "792ef903953b7ef5", "a44b4a48eea008cc", "616b08f3261f6977", 1}});
+}
+
+TEST_F(SceneCompileGolden, SlabOnBelly) {
+  check({"figures/slab_on_belly.yaml", [](SceneDescription& s) { s.bodies[0].offset = Vec3(0, 1.085, 0.08); }, 10,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; bone_gravity@1; contact:slab@0,1",
+          "alice:0/24/18@0 slab:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "9795bcc04e365eb1", "4186a2a4550db76a", "7dca32eb0aabe095", 0}});
+}
+
+TEST_F(SceneCompileGolden, SphereOnBelly) {
+  check({"figures/sphere_on_belly.yaml", at_belly, 10,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; bone_gravity@1; contact:ball@0,1",
+          "alice:0/24/18@0 ball:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "ad8d92391288d1b9", "ac4dbc1327e78a48", "86248d6cd23606eb", 0}});
+}
+
+TEST_F(SceneCompileGolden, YankBelly) {
+  check({"figures/yank_belly.yaml", at_belly, 130,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; coupling:gripper@1; anchor:gripper@alice@0,1",
+          "alice:0/24/18@0 gripper:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "aea730fe525068cc", "8eeb242d76d659e9", "dec85dfb8506dbee", 1}});
+}
+
+// What the example scenes do not use: a tool with a shape, gripper jaws and
+// grasp sensors; a kinematic object on keyframes; soft-tissue damping; a
+// stiffness scale changed after the first step.
+namespace {
+const char* kGripperScene = R"(
+solver: {dt: 1/250, seconds: 0.3, gravity: [0, 0, 0], damping: 0.01}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - name: press
+    shape: {type: box, size: [0.01, 0.01, 0.01]}
+    kind: kinematic
+    keyframes:
+      - {time: 0.0, position: [0.02, 0.04, 0.02]}
+      - {time: 0.2, position: [0.02, 0.032, 0.02]}
+tools:
+  - name: gripper
+    shape: {type: sphere, radius: 0.003}
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.038, 0.0], closure: 1.0}
+      - {time: 0.2, position: [0.0, 0.038, 0.0], closure: 0.0}
+    gripper:
+      hinge: {origin: [0, 0, 0], axis: [1, 0, 0]}
+      jaws:
+        - {shape: {type: capsule, radius: 0.002, length: 0.01}, offset: [0, -0.01, 0.004], side: 1}
+        - {shape: {type: capsule, radius: 0.002, length: 0.01}, offset: [0, -0.01, -0.004], side: -1}
+    grasp:
+      sensors: [{origin: [0, -0.005, 0], direction: [0, -1, 0], range: 0.02}]
+      hardness: 2000
+)";
+
+// The contact patch with a kinematic tool, a coupled tool (which keeps the
+// per-sample penalty) and a static plane.
+const char* kPatchScene = R"(
+solver: {dt: 1/100, seconds: 0.2, gravity: [0, -9.81, 0]}
+contact: {friction: 0, patch: {radius: 0.015}}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - {name: floor, shape: {type: plane, normal: [0, 1, 0]}, kind: static, position: [0, 0.001, 0]}
+tools:
+  - name: probe
+    shape: {type: sphere, radius: 0.01}
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.045, 0.0]}
+      - {time: 0.2, position: [0.0, 0.036, 0.0]}
+  - name: pusher
+    shape: {type: sphere, radius: 0.005}
+    keyframes:
+      - {time: 0.0, position: [0.02, 0.04, 0.0]}
+      - {time: 0.2, position: [0.02, 0.025, 0.0]}
+    coupling: {stiffness: 2000, mass: 0.05, max_force: 100, haptic_gain: 0.5}
+)";
+}  // namespace
+
+TEST_F(SceneCompileGolden, GripperWithJawsDampingAndStiffnessScale) {
+  check({kGripperScene, nullptr, 60,
+         {"inertia@0; elastic@0; damping@0; contact:press@0; contact:gripper@0; contact:gripper/jaw0@0; contact:gripper/jaw1@0; anchor:gripper@base@0",
+          "base:0/24/18@0 dofs 18 blocks 1 groups 1",
+          "bc8fa4eb3d8329cf", "a2e74c403a8021fa", "5ddf143b5d932054", 1},
+         [](SceneSession& s) { s.set_stiffness_scale(2.0); }});
+}
+
+TEST_F(SceneCompileGolden, ContactPatchWithKinematicAndCoupledTools) {
+  check({kPatchScene, nullptr, 20,
+         {"inertia@0; elastic@0; gravity@0; contact:floor@0; contact:probe@0; bone_inertia@1; coupling:pusher@1; contact:pusher@0,1",
+          "base:0/24/18@0 pusher:1/1/0@18 dofs 24 blocks 2 groups 1",
+          "880dcdc197157788", "d3937d106275276b", "ca079c450707b537", 0}});
+}
+
+TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
+  int scenes = 0;
+  for (const char* dir : {"apps/scenes", "apps/scenes/figures"})
+    for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(test::source_dir()) / dir))
+      scenes += e.path().extension() == ".yaml";
+  EXPECT_EQ(scenes, 12) << "a new example scene: add it to SceneCompileGolden";
+}
