@@ -13,6 +13,7 @@
 #include "sflsh/fem/tet_operators.hpp"
 #include "sflsh/sim/compression_guard.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/energies/inertia.hpp"
 #include "sflsh/sim/linearized_stiffness.hpp"
 
 namespace sflsh {
@@ -53,6 +54,8 @@ struct PatchCache : TermCache {
   std::unordered_map<int, int> node_slot;      // node → index into `nodes`
   std::vector<int> tets;                       // tets with a patch node
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
+  std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node
+  std::vector<Vec3> sample_x_star;             // their predictions
   VecX du;                                     // last minimizer (3 per patch node)
   int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
   // The configuration `du` minimizes Φ at (skipped when asked again), and the
@@ -131,6 +134,15 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     const RegionMaterial& m = tet_material(a, t);
     materials_.emplace_back(m, tet_frame(a, t));
     for (int c = 0; c < 4; ++c) node_mass_[a.tet.elements(t, c)] += m.density * tet_volume_[t] / 4.0;
+  }
+  // The inertia cubature's samples by their main node (largest barycentric weight).
+  inertia_points_ = PosedPoints::at_cubature(a, a.inertia);
+  inertia_mass_ = cubature_masses(a, a.inertia);
+  sample_node_.resize(size_t(a.inertia.size()));
+  for (int s = 0; s < a.inertia.size(); ++s) {
+    int k = 0;
+    a.inertia.barycentric.row(s).maxCoeff(&k);
+    sample_node_[size_t(s)] = a.tet.elements(a.inertia.elements[s], k);
   }
   // What the subspace's elastic term holds of each tet (subspace_density).
   if (o.subspace_mean_dilatation) dilatation_cell_ = dilatation_cells(a);
@@ -376,6 +388,14 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     c.d_pred[i] = 2 * h->second.d_t - h->second.d_prev;
     c.du.segment<3>(3 * i) = h->second.du;
   }
+  c.samples_in_patch.clear();
+  c.sample_x_star.clear();
+  for (int s = 0; s < int(sample_node_.size()); ++s)
+    if (c.node_slot.count(sample_node_[s])) {
+      const Vec3 xt = inertia_points_.world_point(s, qt);
+      c.samples_in_patch.push_back(s);
+      c.sample_x_star.push_back(has_prev ? Vec3(2 * xt - inertia_points_.world_point(s, *b.q_prev2)) : xt);
+    }
 }
 
 bool ContactPatchTerm::active(const StepContext& ctx) const {
@@ -415,7 +435,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     const Vec3 d = A[i] * du.segment<3>(3 * i);
     const Vec3 e = d - c.d_pred[i];
     const Vec3 r = nodes_.world_point(n, q) - c.x_star[i];
-    E += 0.5 * m * inv_h2 * (2 * r.dot(e) + e.squaredNorm()) - m * ctx.gravity.dot(d);
+    E += 0.5 * m * inv_h2 * (r + e).squaredNorm() - m * ctx.gravity.dot(d);
     if (!p_derivatives) continue;
     const Vec3 fd = m * inv_h2 * (r + e) - m * ctx.gravity;  // ∂Φ/∂d
     out.gp.segment<3>(3 * i) += A[i].transpose() * fd;
@@ -423,13 +443,32 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     if (!q_derivatives) continue;
     add_offset_rotation_gradient(a.node_weights.row(n), q.bones, du.segment<3>(3 * i), fd, L, out.gq);
     nodes_.local_jacobian(n, q, L, J, cols);
-    const Vec3 ge = m * inv_h2 * e;
+    const Vec3 ge = m * inv_h2 * (r + e);
     const MatX JA = J.transpose() * (m * inv_h2 * A[i]);
+    const MatX JJ = (m * inv_h2) * (J.transpose() * J);
     for (size_t k = 0; k < cols.size(); ++k) {
       out.gq[cols[k]] += J.col(k).dot(ge);
       out.Hqp.block<1, 3>(cols[k], 3 * i) += JA.row(k);
+      for (size_t l = 0; l < cols.size(); ++l) out.Hqq(cols[k], cols[l]) += JJ(long(k), long(l));
     }
   }
+  // What the subspace's inertia term holds of the patch: its samples there
+  // (header comment, "What the patch subtracts").
+  if (mode.subspace_energy || q_derivatives)
+    for (size_t k = 0; k < c.samples_in_patch.size(); ++k) {
+      const int s = c.samples_in_patch[k];
+      const double m = inertia_mass_[s];
+      const Vec3 r = inertia_points_.world_point(s, q) - c.sample_x_star[k];
+      E -= 0.5 * m * inv_h2 * r.squaredNorm();
+      if (!q_derivatives) continue;
+      inertia_points_.local_jacobian(s, q, L, J, cols);
+      const Vec3 gr = m * inv_h2 * r;
+      const MatX JJ = (m * inv_h2) * (J.transpose() * J);
+      for (size_t i = 0; i < cols.size(); ++i) {
+        out.gq[cols[i]] -= J.col(long(i)).dot(gr);
+        for (size_t j = 0; j < cols.size(); ++j) out.Hqq(cols[i], cols[j]) -= JJ(long(i), long(j));
+      }
+    }
 
   // Elasticity: the exact change δu brings to each patch tet.
   // With mean dilatation the subspace holds only α of each tet's own bulk
