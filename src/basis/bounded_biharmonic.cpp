@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "basis/cholmod_llt.hpp"
+#include "basis/edge_path_distance.hpp"
 #include "sflsh/basis/depth_fraction.hpp"
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/fem/tet_operators.hpp"
@@ -23,8 +24,10 @@ namespace {
 
 using SpMat = Eigen::SparseMatrix<double>;
 
-/// Node states of the active-set method: free (inactive) or at a bound.
-enum : char { kFree = 0, kLower = 1, kUpper = 2 };
+/// Node states of the active-set method: free (inactive), at a bound, or
+/// outside the column's support (held at 0, not a bound: never released and
+/// not part of the KKT test).
+enum : char { kFree = 0, kLower = 1, kUpper = 2, kOutside = 3 };
 
 /// Rows/cols `keep` (ascending) of the symmetric column-major A; `map[i]` is
 /// the new index of old index i or −1.
@@ -43,9 +46,11 @@ SpMat principal_submatrix(const SpMat& A, const std::vector<int>& keep, const st
 
 /// Dimensionless KKT residual of x for min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1 with
 /// gradient g = Ax + q (see BbwReport::kkt_residual).
-double kkt_residual(const VecX& x, const VecX& g, double qnorm) {
+/// Nodes marked in `outside` (when non-null) are held values, not bounds: skipped.
+double kkt_residual(const VecX& x, const VecX& g, double qnorm, const std::vector<char>* outside = nullptr) {
   double r = 0.0;
   for (Eigen::Index i = 0; i < x.size(); ++i) {
+    if (outside && (*outside)[size_t(i)]) continue;
     const double viol = std::max({0.0, -x(i), x(i) - 1.0});
     double pg;
     if (x(i) <= 0.0) pg = std::max(0.0, -g(i));
@@ -205,16 +210,17 @@ class InactiveSetSolver {
 /// One bound-constrained QP  min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1, by the primal–dual
 /// active-set method. `dist` (#free): distance (m) of each node to the fixed
 /// nodes with nonzero value; nodes farther than `radius` start at the lower
-/// bound (see BbwOptions::initial_radius_factor).
+/// bound (see BbwOptions::initial_radius_factor). Nodes marked in `outside`
+/// (#free, when non-null) lie outside the column's support: held at 0.
 ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, double radius, const BbwOptions& opt,
-                          int column) {
+                          int column, const std::vector<char>* outside = nullptr) {
   const int n = int(A.rows());
   const double qnorm = std::max(q.lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
   const double mtol = opt.multiplier_tolerance * qnorm;
   ColumnResult res;
   res.x = VecX::Zero(n);
   std::vector<char> state(n);
-  for (int i = 0; i < n; ++i) state[i] = dist(i) <= radius ? kFree : kLower;
+  for (int i = 0; i < n; ++i) state[i] = outside && (*outside)[i] ? kOutside : dist(i) <= radius ? kFree : kLower;
   std::vector<int> released(n, 0);  // releases in the conservative phase, see below
   std::vector<char> frozen(n, 0);
 
@@ -229,7 +235,7 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
     if (num_free > 0) solver.solve(state, q, x);
     res.max_inactive = std::max(res.max_inactive, num_free);
     const VecX g = A * x + q;  // multipliers on the active set
-    res.history.push_back(kkt_residual(x, g, qnorm));
+    res.history.push_back(kkt_residual(x, g, qnorm, outside));
     res.iterations = it;
     res.factorizations = solver.factorizations();
 
@@ -249,7 +255,7 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
         if (x(i) < 0.0) state[i] = kLower, changed = true;
         else if (x(i) > 1.0) state[i] = kUpper, changed = true;
         if (state[i] != kFree && released[i] >= opt.max_releases) frozen[i] = 1;
-      } else if (!(conservative && (primal_violation || frozen[i]))) {
+      } else if (state[i] != kOutside && !(conservative && (primal_violation || frozen[i]))) {
         if ((state[i] == kLower && g(i) < -mtol) || (state[i] == kUpper && g(i) > mtol)) {
           state[i] = kFree;
           if (conservative) ++released[i];
@@ -318,6 +324,9 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
   require(fixed_values.rows() == fixed.size(), "bounded biharmonic weights: ", fixed.size(), " fixed nodes but ",
           fixed_values.rows(), " rows of fixed values");
   require(fixed_values.allFinite(), "bounded biharmonic weights: fixed values must be finite");
+  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
+          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
+          options.support_radius);
   const int C = int(fixed_values.cols());
   std::vector<char> is_fixed(n, 0);
   for (int b = 0; b < fixed.size(); ++b) {
@@ -357,6 +366,10 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
   // a nonzero value in the column; start radius from the volume per column.
   const double volume = fem::lumped_mass(mesh).sum();
   const double radius0 = options.initial_radius_factor * std::cbrt(volume / std::max(C, 1));
+  const bool compact = options.support_radius > 0.0;
+  const EdgeGraph graph = compact ? EdgeGraph(mesh) : EdgeGraph(TetMesh{});
+  std::vector<std::vector<char>> outside(compact ? C : 0);  // per column, #free
+  std::vector<int> support_nodes(compact ? C : 0, 0);
   const double t_setup = timer.seconds();
 
   timer.reset();
@@ -372,7 +385,18 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
         const Vec3 p = mesh.nodes.row(fixed(b)).transpose();
         for (int f = 0; f < nf; ++f) dist(f) = std::min(dist(f), (mesh.nodes.row(free_nodes[f]).transpose() - p).norm());
       }
-      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c);
+      if (compact) {
+        std::vector<int> sources;
+        for (int b = 0; b < fixed.size(); ++b)
+          if (fixed_values(b, c) != 0.0) sources.push_back(fixed(b));
+        const VecX path = graph.distances(sources, options.support_radius);
+        outside[c].assign(size_t(nf), 0);
+        for (int f = 0; f < nf; ++f) {
+          outside[c][f] = !(path(free_nodes[f]) <= options.support_radius);
+          support_nodes[c] += !outside[c][f];
+        }
+      }
+      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c, compact ? &outside[c] : nullptr);
       const int d = ++done;
       if (options.show_progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
@@ -439,8 +463,11 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
     for (int c = 0; c < C && nf > 0; ++c) {
       const VecX& x = results[c].x;
       const double qn = std::max(qcols.col(c).lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
-      r.kkt_residual = std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn));
+      r.kkt_residual =
+          std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn, compact ? &outside[c] : nullptr));
     }
+    r.support_radius = options.support_radius;
+    for (int sn : support_nodes) r.max_support_nodes = std::max(r.max_support_nodes, sn);
   }
   return W;
 }

@@ -1,5 +1,6 @@
 #include "sflsh/precompute/precompute.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -75,6 +76,19 @@ VecX tet_moduli(const Avatar& a) {
   return E;
 }
 
+/// Regions holding at least one tet with a Simulated node.
+int simulated_region_count(const TemplateVolume& tv) {
+  std::vector<char> seen;
+  for (int t = 0; t < tv.tet_region.size(); ++t) {
+    bool simulated = false;
+    for (int c = 0; c < 4; ++c) simulated |= tv.node_role[tv.tet.elements(t, c)] == int(NodeRole::Simulated);
+    if (!simulated) continue;
+    if (int(seen.size()) <= tv.tet_region[t]) seen.resize(size_t(tv.tet_region[t]) + 1, 0);
+    seen[size_t(tv.tet_region[t])] = 1;
+  }
+  return int(std::count(seen.begin(), seen.end(), 1));
+}
+
 }  // namespace
 
 std::string default_cache_dir() {
@@ -133,6 +147,16 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   PrecomputeReport local;
   PrecomputeReport& r = report ? *report : local;
   Timer total;
+  require(options.bbw.support_radius >= 0.0 && std::isfinite(options.bbw.support_radius),
+          "precompute: support radius must be a positive length in metres (or 0 for none), got ",
+          options.bbw.support_radius);
+  if (options.bbw.support_radius > 0.0 && options.handle_positions.rows() == 0) {
+    // Compact supports reach only their own neighbourhood: a region without a
+    // handle would get no soft tissue at all.
+    const int regions = simulated_region_count(tv);
+    require(options.handles >= regions, "precompute: --handles ", options.handles, " is below the ", regions,
+            " simulated regions; with --support-radius every region needs a handle");
+  }
 
   Timer t;
   ShapedVolume shaped = shape_volume(tv, model, betas, options.thickness, options.shape_stage);
@@ -178,6 +202,8 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
                                             options.inertia_samples_per_cell, &r.inertia_fit);
   r.elastic_errors = basis::cubature_errors(a.tet, a.elastic, rho);
   r.inertia_errors = basis::cubature_errors(a.tet, a.inertia, rho);
+  r.elastic_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.elastic);
+  r.inertia_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.inertia);
   r.cubature_s = t.seconds();
   r.shape_stage_s = total.seconds();
   r.peak_rss_mib = peak_rss_mib();
@@ -234,6 +260,13 @@ std::string PrecomputeReport::describe() const {
     << " s, weights " << weights_s << " s, cubature " << cubature_s << " s), peak memory " << peak_rss_mib << " MiB\n";
   if (!template_from_cache) o << template_report.describe() << "\n";
   o << shape_report.describe() << "\n" << bbw_report.summary() << "\n";
+  if (bbw_report.support_radius > 0)
+    o << "compact support: radius " << bbw_report.support_radius << " m along the tet edges, largest support "
+      << bbw_report.max_support_nodes << " nodes\n";
+  for (const auto* h : {&elastic_handles, &inertia_handles})
+    if (h->samples > 0)
+      o << "handles per " << (h == &elastic_handles ? "elastic" : "inertia") << " sample: mean " << h->mean
+        << ", max " << h->max << " (" << h->samples << " samples)\n";
   // (coverage: printed by the avatar summary, see summarize_avatar.)
   o << std::setprecision(3);
   // CubatureErrors holds relative errors already.
