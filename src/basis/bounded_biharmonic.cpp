@@ -4,6 +4,7 @@
 #include <atomic>
 #include <exception>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <sstream>
@@ -298,6 +299,10 @@ void check_components_anchored(const TetMesh& mesh, const std::vector<char>& is_
             " belongs to no tet; remove unreferenced nodes or fix them");
 }
 
+
+MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
+                  const BbwOptions& options, BbwReport* report);
+
 }  // namespace
 
 std::string BbwReport::summary() const {
@@ -320,13 +325,22 @@ std::string BbwReport::summary() const {
 
 MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values,
                            const BbwOptions& options, BbwReport* report) {
+  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
+          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
+          options.support_radius);
+  return supported_qp(mesh, fixed, fixed_values, VecX::Constant(fixed_values.cols(), options.support_radius), options,
+                      report);
+}
+
+namespace {
+
+/// bounded_biharmonic_qp with a support radius per column (m; 0 = unrestricted).
+MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
+                  const BbwOptions& options, BbwReport* report) {
   const int n = mesh.num_nodes();
   require(fixed_values.rows() == fixed.size(), "bounded biharmonic weights: ", fixed.size(), " fixed nodes but ",
           fixed_values.rows(), " rows of fixed values");
   require(fixed_values.allFinite(), "bounded biharmonic weights: fixed values must be finite");
-  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
-          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
-          options.support_radius);
   const int C = int(fixed_values.cols());
   std::vector<char> is_fixed(n, 0);
   for (int b = 0; b < fixed.size(); ++b) {
@@ -366,7 +380,7 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
   // a nonzero value in the column; start radius from the volume per column.
   const double volume = fem::lumped_mass(mesh).sum();
   const double radius0 = options.initial_radius_factor * std::cbrt(volume / std::max(C, 1));
-  const bool compact = options.support_radius > 0.0;
+  const bool compact = C > 0 && support_radius.maxCoeff() > 0.0;
   const EdgeGraph graph = compact ? EdgeGraph(mesh) : EdgeGraph(TetMesh{});
   std::vector<std::vector<char>> outside(compact ? C : 0);  // per column, #free
   std::vector<int> support_nodes(compact ? C : 0, 0);
@@ -385,18 +399,19 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
         const Vec3 p = mesh.nodes.row(fixed(b)).transpose();
         for (int f = 0; f < nf; ++f) dist(f) = std::min(dist(f), (mesh.nodes.row(free_nodes[f]).transpose() - p).norm());
       }
-      if (compact) {
+      if (compact && support_radius[c] > 0.0) {
         std::vector<int> sources;
         for (int b = 0; b < fixed.size(); ++b)
           if (fixed_values(b, c) != 0.0) sources.push_back(fixed(b));
-        const VecX path = graph.distances(sources, options.support_radius);
+        const VecX path = graph.distances(sources, support_radius[c]);
         outside[c].assign(size_t(nf), 0);
         for (int f = 0; f < nf; ++f) {
-          outside[c][f] = !(path(free_nodes[f]) <= options.support_radius);
+          outside[c][f] = !(path(free_nodes[f]) <= support_radius[c]);
           support_nodes[c] += !outside[c][f];
         }
       }
-      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c, compact ? &outside[c] : nullptr);
+      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c,
+                                outside.empty() || outside[c].empty() ? nullptr : &outside[c]);
       const int d = ++done;
       if (options.show_progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
@@ -464,13 +479,16 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
       const VecX& x = results[c].x;
       const double qn = std::max(qcols.col(c).lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
       r.kkt_residual =
-          std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn, compact ? &outside[c] : nullptr));
+          std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn,
+                                                outside.empty() || outside[c].empty() ? nullptr : &outside[c]));
     }
-    r.support_radius = options.support_radius;
+    r.support_radius = C > 0 ? support_radius.maxCoeff() : 0.0;
     for (int sn : support_nodes) r.max_support_nodes = std::max(r.max_support_nodes, sn);
   }
   return W;
 }
+
+}  // namespace
 
 VecX bone_weight(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W) {
   VecX s = W * VecX::Ones(W.cols());
@@ -513,9 +531,29 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> bounded_biharmonic_weights(const Te
   for (size_t b = 0; b < fixed.size(); ++b)
     if (value_col[b] >= 0) values(Eigen::Index(b), value_col[b]) = 1.0;
 
+  // Support radius of each handle (m; 0 = unrestricted).
+  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
+          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
+          options.support_radius);
+  require(options.support_spacing_factor >= 0.0 && std::isfinite(options.support_spacing_factor),
+          "bounded biharmonic weights: support spacing factor must be positive (or 0 for none), got ",
+          options.support_spacing_factor);
+  require(!(options.support_radius > 0.0 && options.support_spacing_factor > 0.0),
+          "bounded biharmonic weights: give a support radius or a support spacing factor, not both");
+  VecX radius = VecX::Constant(K, options.support_radius);
+  if (options.support_spacing_factor > 0.0) {
+    require(K >= 2, "bounded biharmonic weights: a support spacing factor needs at least 2 handles, got ", K);
+    for (int k = 0; k < K; ++k) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int l = 0; l < K; ++l)
+        if (l != k) nearest = std::min(nearest, (mesh.nodes.row(handle_nodes(k)) - mesh.nodes.row(handle_nodes(l))).norm());
+      radius[k] = options.support_spacing_factor * nearest;
+    }
+  }
+
   BbwReport local;
   BbwReport& r = report ? *report : local;
-  MatX Wd = bounded_biharmonic_qp(mesh, fixed_v, values, options, &r);
+  MatX Wd = supported_qp(mesh, fixed_v, values, radius, options, &r);
 
   // Dirichlet: rescale rows with Σ_k w_k > 1. DepthBlend: every Simulated row
   // to b_i · w̃ / max(Σ w̃, floor), other rows 0 (see the header). Then sparsify.

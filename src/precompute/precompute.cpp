@@ -150,12 +150,17 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   require(options.bbw.support_radius >= 0.0 && std::isfinite(options.bbw.support_radius),
           "precompute: support radius must be a positive length in metres (or 0 for none), got ",
           options.bbw.support_radius);
-  if (options.bbw.support_radius > 0.0 && options.handle_positions.rows() == 0) {
+  require(options.bbw.support_spacing_factor >= 0.0 && std::isfinite(options.bbw.support_spacing_factor),
+          "precompute: support spacing factor must be positive (or 0 for none), got ",
+          options.bbw.support_spacing_factor);
+  if ((options.bbw.support_radius > 0.0 || options.bbw.support_spacing_factor > 0.0) &&
+      options.handle_positions.rows() == 0) {
     // Compact supports reach only their own neighbourhood: a region without a
     // handle would get no soft tissue at all.
     const int regions = simulated_region_count(tv);
     require(options.handles >= regions, "precompute: --handles ", options.handles, " is below the ", regions,
-            " simulated regions; with --support-radius every region needs a handle");
+            " simulated regions; with compact supports (--support-radius, --support-spacing) every region needs a "
+            "handle");
   }
 
   Timer t;
@@ -261,7 +266,7 @@ std::string PrecomputeReport::describe() const {
   if (!template_from_cache) o << template_report.describe() << "\n";
   o << shape_report.describe() << "\n" << bbw_report.summary() << "\n";
   if (bbw_report.support_radius > 0)
-    o << "compact support: radius " << bbw_report.support_radius << " m along the tet edges, largest support "
+    o << "compact support: largest radius " << bbw_report.support_radius << " m along the tet edges, largest support "
       << bbw_report.max_support_nodes << " nodes\n";
   for (const auto* h : {&elastic_handles, &inertia_handles})
     if (h->samples > 0)

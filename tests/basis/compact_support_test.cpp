@@ -157,7 +157,9 @@ void check_compact_basis(BoneCondition condition) {
     const VecX d = path_lengths(s.mesh, hs.nodes(k));
     int inside = 0;
     for (int i = 0; i < s.mesh.num_nodes(); ++i) {
-      if (d(i) > radius * (1 + 1e-12)) EXPECT_EQ(Wd(i, k), 0.0) << "handle " << k << " node " << i << " at path length " << d(i);
+      if (d(i) > radius * (1 + 1e-12)) {
+        EXPECT_EQ(Wd(i, k), 0.0) << "handle " << k << " node " << i << " at path length " << d(i);
+      }
       inside += d(i) <= radius && Wd(i, k) > 0.0;
     }
     EXPECT_GT(inside, 1) << "handle " << k;
@@ -167,7 +169,9 @@ void check_compact_basis(BoneCondition condition) {
   }
   // Dirichlet nodes stay at 0.
   for (int i = 0; i < s.mesh.num_nodes(); ++i)
-    if (s.role(i) != 0) EXPECT_EQ(Wd.row(i).lpNorm<Eigen::Infinity>(), 0.0) << "Dirichlet node " << i;
+    if (s.role(i) != 0) {
+      EXPECT_EQ(Wd.row(i).lpNorm<Eigen::Infinity>(), 0.0) << "Dirichlet node " << i;
+    }
   // Partition of unity with the bone complement everywhere; with DepthBlend the
   // handles alone sum to the depth fraction wherever a handle reaches.
   EXPECT_LT((sums + wb - VecX::Ones(sums.size())).lpNorm<Eigen::Infinity>(), 1e-12);
@@ -175,7 +179,9 @@ void check_compact_basis(BoneCondition condition) {
     const VecX b = depth_fraction(s.mesh, s.role);
     EXPECT_EQ(rep.nodes_unreached, 0);  // the radius reaches every node of this slab
     for (int i = 0; i < s.mesh.num_nodes(); ++i)
-      if (s.role(i) == 0) EXPECT_NEAR(sums(i), b(i), K * BbwOptions().drop_tolerance) << "node " << i;
+      if (s.role(i) == 0) {
+        EXPECT_NEAR(sums(i), b(i), K * BbwOptions().drop_tolerance) << "node " << i;
+      }
   }
   // Smaller supports than without a radius.
   EXPECT_LT(W.nonZeros(), W_full.nonZeros());
@@ -221,6 +227,54 @@ TEST(CompactSupport, RejectsABadRadius) {
       EXPECT_NE(std::string(e.what()).find("support radius"), std::string::npos) << e.what();
     }
   }
+}
+
+}  // namespace
+}  // namespace sflsh::basis
+
+namespace sflsh::basis {
+namespace {
+
+// Supports sized by the handle spacing: handle k's radius is the factor times
+// the distance to its nearest other handle (computed here independently).
+TEST(CompactSupport, SpacingFactorGivesEachHandleItsOwnRadius) {
+  const Slab s = slab();
+  const int K = 8;
+  const double factor = 1.5;
+  const HandleSet hs = select_handles(s.mesh, s.role, K);
+  BbwOptions o = quiet(BoneCondition::DepthBlend, 0.0);
+  o.support_spacing_factor = factor;
+  BbwReport rep;
+  const MatX Wd = MatX(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, o, &rep));
+  double largest = 0.0;
+  int truncated = 0;  // handles whose radius cuts their unrestricted support
+  const MatX Wfull = MatX(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, quiet(BoneCondition::DepthBlend, 0.0)));
+  for (int k = 0; k < K; ++k) {
+    double nearest = 1e300;
+    for (int l = 0; l < K; ++l)
+      if (l != k) nearest = std::min(nearest, (s.mesh.nodes.row(hs.nodes(k)) - s.mesh.nodes.row(hs.nodes(l))).norm());
+    const double r = factor * nearest;
+    largest = std::max(largest, r);
+    const VecX d = path_lengths(s.mesh, hs.nodes(k));
+    bool cut = false;
+    for (int i = 0; i < s.mesh.num_nodes(); ++i) {
+      if (d(i) > r * (1 + 1e-12)) {
+        EXPECT_EQ(Wd(i, k), 0.0) << "handle " << k << " node " << i << " at " << d(i) << " beyond " << r;
+        cut |= Wfull(i, k) > 0.0;
+      }
+    }
+    truncated += cut;
+  }
+  EXPECT_GT(truncated, 0);  // the radii matter on this slab
+  EXPECT_NEAR(rep.support_radius, largest, 1e-12);
+  EXPECT_GE(Wd.minCoeff(), 0.0);
+  EXPECT_LE(Wd.rowwise().sum().maxCoeff(), 1.0 + 1e-12);
+  // A radius and a factor together, or a bad factor: errors.
+  o.support_radius = 0.1;
+  EXPECT_THROW(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, o), Error);
+  o.support_radius = 0.0;
+  o.support_spacing_factor = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(bounded_biharmonic_weights(s.mesh, s.role, hs.nodes, o), Error);
 }
 
 }  // namespace
