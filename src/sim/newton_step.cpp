@@ -183,9 +183,11 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     Timer ts;
     bool solved = false;
     if (o.linear_solver == LinearSolver::Sparse) {
-      if (!sys.sparse_solver) sys.sparse_solver = std::make_shared<SparseHessianSolver>();
+      if (!sys.sparse_solver)
+        sys.sparse_solver = o.sparse_always ? std::make_shared<SparseHessianSolver>(1.0, 0.0)
+                                            : std::make_shared<SparseHessianSolver>();
       solved = sys.sparse_solver->solve(H, g, delta);
-      if (solved) rep.regularization = 0.0;
+      if (solved) rep.regularization = 0.0, ++rep.sparse_solves;
     }
     if (!solved) solve_in_place(H, g, o.regularization, delta, &rep.regularization);
     rep.ms_solve += ts.ms();

@@ -47,10 +47,9 @@ void SparseHessianSolver::widen(const MatX& H) {
   A_.makeCompressed();
   ldlt_.analyzePattern(A_);
   ++analyses_;
-}
-
-long SparseHessianSolver::factor_nonzeros() const {
-  return analyses_ > 0 ? long(ldlt_.matrixL().nestedExpression().nonZeros()) : 0;
+  factor_flops_ = 0;
+  for (Eigen::Index j = 0; j < ldlt_.column_counts().size(); ++j)
+    factor_flops_ += double(ldlt_.column_counts()[j]) * double(ldlt_.column_counts()[j]);
 }
 
 bool SparseHessianSolver::solve(const MatX& H, const VecX& g, VecX& delta) {
@@ -60,6 +59,7 @@ bool SparseHessianSolver::solve(const MatX& H, const VecX& g, VecX& delta) {
     fill(H);
   }
   if (double(A_.nonZeros()) > max_density_ * 0.5 * double(n) * double(n + 1)) return false;
+  if (simplicial_slowdown_ * factor_flops_ > double(n) * double(n) * double(n) / 3.0) return false;
   ldlt_.factorize(A_);
   if (ldlt_.info() != Eigen::Success || !(ldlt_.vectorD().minCoeff() > 0.0)) return false;
   delta = ldlt_.solve(-g);

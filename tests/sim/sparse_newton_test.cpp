@@ -85,7 +85,7 @@ TEST(SparseNewton, SoftBlockPatternIsTheSupportOverlapsAndTheStepMatchesTheDense
   for (const auto& [k, l] : pairs) expected += k == l ? 6 : 9;
   ASSERT_LT(expected, long(n) * (n + 1) / 2 / 2);  // sparse: less than half the lower triangle
 
-  SparseHessianSolver sparse(1.0);  // any density: the small body's pattern is half full
+  SparseHessianSolver sparse(1.0, 0.0);  // any density and cost: the small body's pattern is half full
   VecX delta;
   ASSERT_TRUE(sparse.solve(H, g, delta));
   EXPECT_EQ(sparse.pattern_nonzeros(), expected);
@@ -120,6 +120,14 @@ TEST(SparseNewton, DeclinesADensePatternAndAnIndefiniteSystem) {
   VecX delta;
   const MatX dense = MatX::Identity(20, 20) + MatX::Constant(20, 20, 0.01);
   EXPECT_FALSE(sparse.solve(dense, VecX::Ones(20), delta));
+  // A tridiagonal pattern costs ~n multiply-adds against n³/3: taken, unless
+  // a simplicial factorization is assumed slower than n² / 3 times the dense one.
+  MatX tri = 4.0 * MatX::Identity(60, 60);
+  for (int i = 0; i + 1 < 60; ++i) tri(i, i + 1) = tri(i + 1, i) = -1.0;
+  SparseHessianSolver cheap, pessimist(0.3, 1e5);
+  EXPECT_TRUE(cheap.solve(tri, VecX::Ones(60), delta));
+  EXPECT_DOUBLE_EQ(cheap.factor_flops(), 59.0);  // one subdiagonal entry in 59 columns of L (AMD keeps a path a path)
+  EXPECT_FALSE(pessimist.solve(tri, VecX::Ones(60), delta));
   MatX indefinite = MatX::Identity(20, 20);
   indefinite(3, 3) = -1.0;
   SparseHessianSolver other;
@@ -131,12 +139,14 @@ Configuration run(LinearSolver solver, int steps) {
   SimulatorOptions o;
   o.bones_dynamic = true;
   o.newton.linear_solver = solver;
+  o.newton.sparse_always = true;  // this body's pattern is too dense to pay; the path is what is tested
   const auto a = small_body();
   const SkeletonTermsOptions skeleton;
   Simulator sim(avatar_model(a, o, &skeleton));
   for (int i = 1; i <= steps; ++i) {
     const StepReport rep = sim.step(test::synthetic_motion(*a, i * o.h, 0.03, 0.5));
     EXPECT_EQ(rep.regularization, 0.0) << "step " << i;
+    EXPECT_EQ(rep.sparse_solves, solver == LinearSolver::Sparse ? rep.iterations : 0) << "step " << i;
   }
   return sim.state();
 }

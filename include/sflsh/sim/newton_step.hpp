@@ -81,6 +81,9 @@ struct NewtonOptions {
   double regularization = 1e-10;
   /// Factorization of the Newton system (LinearSolver).
   LinearSolver linear_solver = LinearSolver::Dense;
+  /// LinearSolver::Sparse: factor sparsely whatever the pattern's density and
+  /// cost (tests of the sparse path on bodies too small for it to pay).
+  bool sparse_always = false;
   /// Evaluate energy and gradient at the final configuration for the report
   /// (costs one gradient evaluation; needed for energy_after/grad_norm_after).
   bool report_final = true;

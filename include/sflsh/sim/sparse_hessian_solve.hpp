@@ -12,8 +12,12 @@
 // densely). Each solve reads H's lower triangle against the stored pattern;
 // an entry outside it (a term that was inactive until now, a new contact
 // block) widens the pattern to the union and analyses it again. A pattern
-// denser than `max_density` is not worth a sparse factorization: solve()
-// then declines and the caller factors H densely.
+// not worth a sparse factorization is declined (solve() returns false and
+// the caller factors H densely): one denser than `max_density`, or one whose
+// factorization, by the symbolic analysis' column counts c_j of L, costs
+// Σ_j c_j² multiply-adds more than 1/`simplicial_slowdown` of the dense
+// Cholesky's n³/3 (a simplicial factorization works column by column,
+// without the dense one's blocked, vectorized kernels).
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
@@ -23,7 +27,8 @@ namespace sflsh {
 
 class SparseHessianSolver {
  public:
-  explicit SparseHessianSolver(double max_density = 0.3) : max_density_(max_density) {}
+  explicit SparseHessianSolver(double max_density = 0.3, double simplicial_slowdown = 4.0)
+      : max_density_(max_density), simplicial_slowdown_(simplicial_slowdown) {}
   /// δ = −H⁻¹ g from H's lower triangle (H symmetric; a zero diagonal entry
   /// counts as 1, as in the dense solve: its DoF is decoupled). Returns false,
   /// leaving δ unspecified, when the pattern is too dense or H is not positive
@@ -33,8 +38,8 @@ class SparseHessianSolver {
   long pattern_nonzeros() const { return A_.nonZeros(); }
   /// Symbolic analyses so far (1 when the pattern never changed).
   int analyses() const { return analyses_; }
-  /// Nonzeros of the factor L (strict lower triangle), after the last analysis.
-  long factor_nonzeros() const;
+  /// Multiply-adds of one numeric factorization of the analysed pattern, Σ_j c_j².
+  double factor_flops() const { return factor_flops_; }
 
  private:
   /// Copies H's lower triangle onto the pattern; false if H has an entry outside it.
@@ -42,10 +47,16 @@ class SparseHessianSolver {
   /// Sets the pattern to the union of the current one and H's lower-triangle nonzeros.
   void widen(const MatX& H);
 
-  double max_density_;
+  /// Eigen's LDLᵀ with the symbolic column counts of L exposed.
+  struct LDLT : Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> {
+    const Eigen::VectorXi& column_counts() const { return m_nonZerosPerCol; }
+  };
+
+  double max_density_, simplicial_slowdown_;
   Eigen::SparseMatrix<double> A_;  ///< lower triangle, column-major
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  LDLT ldlt_;
   int analyses_ = 0;
+  double factor_flops_ = 0;
 };
 
 }  // namespace sflsh
