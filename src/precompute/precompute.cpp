@@ -17,6 +17,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/io/input_file.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 namespace sflsh {
 
@@ -76,17 +77,21 @@ VecX tet_moduli(const Avatar& a) {
   return E;
 }
 
-/// Regions holding at least one tet with a Simulated node.
-int simulated_region_count(const TemplateVolume& tv) {
-  std::vector<char> seen;
-  for (int t = 0; t < tv.tet_region.size(); ++t) {
-    bool simulated = false;
-    for (int c = 0; c < 4; ++c) simulated |= tv.node_role[tv.tet.elements(t, c)] == int(NodeRole::Simulated);
-    if (!simulated) continue;
-    if (int(seen.size()) <= tv.tet_region[t]) seen.resize(size_t(tv.tet_region[t]) + 1, 0);
-    seen[size_t(tv.tet_region[t])] = 1;
-  }
-  return int(std::count(seen.begin(), seen.end(), 1));
+/// Regions the handle placement serves: those whose Simulated nodes hold at
+/// least `min_fraction` of the Simulated volume (basis::allocate_handles'
+/// threshold; the head's, hands' and feet's few Simulated border nodes fall
+/// below it).
+int simulated_region_count(const TemplateVolume& tv, double min_fraction) {
+  if (tv.tet_region.size() == 0) return 1;
+  const int R = 1 + tv.tet_region.maxCoeff();
+  const VecXi node_region = basis::node_regions_from_tets(tv.tet, tv.tet_region, R);
+  const VecX volume = fem::lumped_mass(tv.tet);
+  VecX per_region = VecX::Zero(R);
+  for (int i = 0; i < tv.tet.num_nodes(); ++i)
+    if (tv.node_role[i] == int(NodeRole::Simulated) && node_region[i] >= 0) per_region[node_region[i]] += volume[i];
+  int count = 0;
+  for (int r = 0; r < R; ++r) count += per_region[r] > 0.0 && per_region[r] >= min_fraction * per_region.sum();
+  return count;
 }
 
 }  // namespace
@@ -157,7 +162,7 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
       options.handle_positions.rows() == 0) {
     // Compact supports reach only their own neighbourhood: a region without a
     // handle would get no soft tissue at all.
-    const int regions = simulated_region_count(tv);
+    const int regions = simulated_region_count(tv, options.placement.min_region_fraction);
     require(options.handles >= regions, "precompute: --handles ", options.handles, " is below the ", regions,
             " simulated regions; with compact supports (--support-radius, --support-spacing) every region needs a "
             "handle");

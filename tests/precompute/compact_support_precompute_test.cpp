@@ -53,15 +53,20 @@ TEST(CompactSupportPrecompute, RadiusBoundsTheSupportsAndTheHandlesPerSample) {
             basis::handles_per_sample(compact.tet, compact.W, compact.node_role, compact.elastic).mean);
   EXPECT_EQ(rep.bbw_report.support_radius, 0.12);
 
-  // Fewer handles than simulated regions (9 on the built-in body): refused.
-  PrecomputeOptions few = coarse(5);
+  // Fewer handles than simulated regions (9 on the built-in body): refused;
+  // as many as there are is accepted.
+  PrecomputeOptions enough = coarse(9);
+  enough.bbw.support_radius = 0.12;
+  EXPECT_NO_THROW(precompute_shape(tv, model, VecX(), enough));
+  PrecomputeOptions few = coarse(8);
   few.placement.min_per_region = 0;
   few.bbw.support_radius = 0.12;
   try {
     precompute_shape(tv, model, VecX(), few);
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("simulated regions"), std::string::npos) << e.what();
+    // torso, belly, chest, buttocks, thigh, calf, upper arm, forearm, neck.
+    EXPECT_NE(std::string(e.what()).find("below the 9 simulated regions"), std::string::npos) << e.what();
   }
   few.bbw.support_radius = -1.0;
   EXPECT_THROW(precompute_shape(tv, model, VecX(), few), Error);
