@@ -23,6 +23,10 @@ struct BenchArgs {
   int variants_handles = BenchOptions().default_handles;
   double seconds = 0;
   bool seconds_given = false;
+  std::string support_spacing;  // dimensionless; empty = off
+  std::string support_radius;          // m; empty = unrestricted supports
+  std::string linear_solver = "dense";  // dense | sparse
+  bool cpu_time = false;
 };
 
 void run_bench(const BenchArgs& a) {
@@ -41,6 +45,25 @@ void run_bench(const BenchArgs& a) {
   require(a.inertia_samples_per_cell >= 0 && a.inertia_samples_per_cell <= 1000,
           "--inertia-samples-per-cell must be in [0, 1000], got ", a.inertia_samples_per_cell);
   o.precompute.inertia_samples_per_cell = a.inertia_samples_per_cell;
+  if (!a.support_radius.empty()) {
+    char* end = nullptr;
+    const double r = std::strtod(a.support_radius.c_str(), &end);
+    require(end != a.support_radius.c_str() && *end == '\0' && std::isfinite(r) && r > 0 && r <= 10,
+            "--support-radius must be a length in (0, 10] m, got '", a.support_radius, "'");
+    o.precompute.bbw.support_radius = r;
+  }
+  if (!a.support_spacing.empty()) {
+    char* end = nullptr;
+    const double f = std::strtod(a.support_spacing.c_str(), &end);
+    require(end != a.support_spacing.c_str() && *end == '\0' && std::isfinite(f) && f > 0 && f <= 100,
+            "--support-spacing must be a factor in (0, 100], got '", a.support_spacing, "'");
+    require(a.support_radius.empty(), "--support-spacing and --support-radius exclude each other");
+    o.precompute.bbw.support_spacing_factor = f;
+  }
+  require(a.linear_solver == "dense" || a.linear_solver == "sparse", "--linear-solver must be dense or sparse, got '",
+          a.linear_solver, "'");
+  o.linear_solver = a.linear_solver == "sparse" ? LinearSolver::Sparse : LinearSolver::Dense;
+  o.cpu_time = a.cpu_time;
   if (!a.betas.empty()) o.betas = parse_betas(a.betas);
   if (!a.handles.empty()) {
     VecX k;
@@ -105,6 +128,16 @@ const CommandRegistrar reg(50, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-cache", a->no_cache, "Do not use the template-stage cache");
   cmd->add_flag("--peer,!--no-peer", a->peer, "Run the Bullet 3 deformable-FEM peer rows (default on)");
+  cmd->add_option("--support-spacing", a->support_spacing,
+                  "Compact support sized by the handle spacing: each handle's radius (along the tet edges) is this "
+                  "factor times the distance to its nearest handle (as precompute --support-spacing)");
+  cmd->add_option("--support-radius", a->support_radius,
+                  "Compact-support basis for every avatar built (as precompute --support-radius, m)");
+  cmd->add_option("--linear-solver", a->linear_solver,
+                  "Newton system of the reduced rows: dense (Cholesky) or sparse (LDLT of the analysed pattern)")
+      ->capture_default_str();
+  cmd->add_flag("--cpu-time", a->cpu_time,
+                "Reduced rows' ms per step as the stepping thread's CPU time (a machine shared with other jobs)");
   cmd->add_option("--out", a->out, "Output folder (bench.csv, bench.md, bench.svg)")->capture_default_str();
   cmd->callback([a, seconds] {
     a->seconds_given = seconds->count() > 0;

@@ -35,6 +35,8 @@ struct PrecomputeArgs {
   int elastic_samples_per_cell = PrecomputeOptions().elastic_samples_per_cell;
   int inertia_samples_per_cell = PrecomputeOptions().inertia_samples_per_cell;
   int handles_min_per_region = PrecomputeOptions().placement.min_per_region;
+  std::string support_spacing;  // dimensionless; empty = off
+  std::string support_radius;  // m; empty = unrestricted supports (the default)
   bool no_fit_cubature = false;
   std::string handles_file, thickness_map, out = "avatar.h5", batch, out_dir, cache_dir;
   bool no_cache = false, template_only = false, dry_run = false;
@@ -69,6 +71,21 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
   if (a.facet_distance > 0) o.template_stage.mesh.facet_distance = a.facet_distance;
   require(a.threads >= 0 && a.threads <= 1024, "--threads must be in [1, 1024] (or 0 for all cores), got ", a.threads);
   o.bbw.threads = a.threads;
+  if (!a.support_radius.empty()) {
+    char* end = nullptr;
+    const double r = std::strtod(a.support_radius.c_str(), &end);
+    require(end != a.support_radius.c_str() && *end == '\0' && std::isfinite(r) && r > 0 && r <= 10,
+            "--support-radius must be a length in (0, 10] m, got '", a.support_radius, "'");
+    o.bbw.support_radius = r;
+  }
+  if (!a.support_spacing.empty()) {
+    char* end = nullptr;
+    const double f = std::strtod(a.support_spacing.c_str(), &end);
+    require(end != a.support_spacing.c_str() && *end == '\0' && std::isfinite(f) && f > 0 && f <= 100,
+            "--support-spacing must be a factor in (0, 100], got '", a.support_spacing, "'");
+    require(a.support_radius.empty(), "--support-spacing and --support-radius exclude each other");
+    o.bbw.support_spacing_factor = f;
+  }
   return o;
 }
 
@@ -95,6 +112,8 @@ std::vector<std::string> worker_command(const PrecomputeArgs& a, const Precomput
                                 std::to_string(a.inertia_samples_per_cell), "--handles-min-per-region",
                                 std::to_string(a.handles_min_per_region), "--cache-dir", o.cache_dir};
   if (a.no_fit_cubature) c.push_back("--no-fit-cubature");
+  if (!a.support_radius.empty()) c.insert(c.end(), {"--support-radius", a.support_radius});
+  if (!a.support_spacing.empty()) c.insert(c.end(), {"--support-spacing", a.support_spacing});
   for (const auto& [flag, value] : {std::pair<const char*, const std::string*>{"--handles-file", &a.handles_file},
                                     {"--thickness-map", &a.thickness_map}})
     if (!value->empty()) c.insert(c.end(), {flag, *value});
@@ -324,6 +343,12 @@ const CommandRegistrar reg(20, [](CLI::App& app) {
                   "thickness^0.5; the rest go by that weight; "
                   "more gives the limbs and neck finer soft DoFs at the torso's expense)")
       ->capture_default_str();
+  cmd->add_option("--support-spacing", a->support_spacing,
+                  "Compact support sized by the handle spacing: each handle's radius (along the tet edges) is this "
+                  "factor times the distance to its nearest handle");
+  cmd->add_option("--support-radius", a->support_radius,
+                  "Compact support: each handle's weight is 0 beyond this path length along the tet edges (m); "
+                  "needs --handles >= the number of simulated regions (default: unrestricted)");
   cmd->add_flag("--no-fit-cubature", a->no_fit_cubature,
                 "Keep the stratified elastic cubature's volume weights (no stiffness fit)");
   cmd->add_option("--handles-file", a->handles_file, "Handle positions, one 'x y z' per line (metres, unposed)");

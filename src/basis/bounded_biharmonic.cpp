@@ -4,6 +4,7 @@
 #include <atomic>
 #include <exception>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <sstream>
@@ -11,6 +12,7 @@
 #include <thread>
 
 #include "basis/cholmod_llt.hpp"
+#include "basis/edge_path_distance.hpp"
 #include "sflsh/basis/depth_fraction.hpp"
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/fem/tet_operators.hpp"
@@ -23,8 +25,10 @@ namespace {
 
 using SpMat = Eigen::SparseMatrix<double>;
 
-/// Node states of the active-set method: free (inactive) or at a bound.
-enum : char { kFree = 0, kLower = 1, kUpper = 2 };
+/// Node states of the active-set method: free (inactive), at a bound, or
+/// outside the column's support (held at 0, not a bound: never released and
+/// not part of the KKT test).
+enum : char { kFree = 0, kLower = 1, kUpper = 2, kOutside = 3 };
 
 /// Rows/cols `keep` (ascending) of the symmetric column-major A; `map[i]` is
 /// the new index of old index i or −1.
@@ -43,9 +47,11 @@ SpMat principal_submatrix(const SpMat& A, const std::vector<int>& keep, const st
 
 /// Dimensionless KKT residual of x for min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1 with
 /// gradient g = Ax + q (see BbwReport::kkt_residual).
-double kkt_residual(const VecX& x, const VecX& g, double qnorm) {
+/// Nodes marked in `outside` (when non-null) are held values, not bounds: skipped.
+double kkt_residual(const VecX& x, const VecX& g, double qnorm, const std::vector<char>* outside = nullptr) {
   double r = 0.0;
   for (Eigen::Index i = 0; i < x.size(); ++i) {
+    if (outside && (*outside)[size_t(i)]) continue;
     const double viol = std::max({0.0, -x(i), x(i) - 1.0});
     double pg;
     if (x(i) <= 0.0) pg = std::max(0.0, -g(i));
@@ -205,16 +211,17 @@ class InactiveSetSolver {
 /// One bound-constrained QP  min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1, by the primal–dual
 /// active-set method. `dist` (#free): distance (m) of each node to the fixed
 /// nodes with nonzero value; nodes farther than `radius` start at the lower
-/// bound (see BbwOptions::initial_radius_factor).
+/// bound (see BbwOptions::initial_radius_factor). Nodes marked in `outside`
+/// (#free, when non-null) lie outside the column's support: held at 0.
 ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, double radius, const BbwOptions& opt,
-                          int column) {
+                          int column, const std::vector<char>* outside = nullptr) {
   const int n = int(A.rows());
   const double qnorm = std::max(q.lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
   const double mtol = opt.multiplier_tolerance * qnorm;
   ColumnResult res;
   res.x = VecX::Zero(n);
   std::vector<char> state(n);
-  for (int i = 0; i < n; ++i) state[i] = dist(i) <= radius ? kFree : kLower;
+  for (int i = 0; i < n; ++i) state[i] = outside && (*outside)[i] ? kOutside : dist(i) <= radius ? kFree : kLower;
   std::vector<int> released(n, 0);  // releases in the conservative phase, see below
   std::vector<char> frozen(n, 0);
 
@@ -229,7 +236,7 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
     if (num_free > 0) solver.solve(state, q, x);
     res.max_inactive = std::max(res.max_inactive, num_free);
     const VecX g = A * x + q;  // multipliers on the active set
-    res.history.push_back(kkt_residual(x, g, qnorm));
+    res.history.push_back(kkt_residual(x, g, qnorm, outside));
     res.iterations = it;
     res.factorizations = solver.factorizations();
 
@@ -249,7 +256,7 @@ ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, doubl
         if (x(i) < 0.0) state[i] = kLower, changed = true;
         else if (x(i) > 1.0) state[i] = kUpper, changed = true;
         if (state[i] != kFree && released[i] >= opt.max_releases) frozen[i] = 1;
-      } else if (!(conservative && (primal_violation || frozen[i]))) {
+      } else if (state[i] != kOutside && !(conservative && (primal_violation || frozen[i]))) {
         if ((state[i] == kLower && g(i) < -mtol) || (state[i] == kUpper && g(i) > mtol)) {
           state[i] = kFree;
           if (conservative) ++released[i];
@@ -292,6 +299,10 @@ void check_components_anchored(const TetMesh& mesh, const std::vector<char>& is_
             " belongs to no tet; remove unreferenced nodes or fix them");
 }
 
+
+MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
+                  const BbwOptions& options, BbwReport* report);
+
 }  // namespace
 
 std::string BbwReport::summary() const {
@@ -314,6 +325,18 @@ std::string BbwReport::summary() const {
 
 MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values,
                            const BbwOptions& options, BbwReport* report) {
+  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
+          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
+          options.support_radius);
+  return supported_qp(mesh, fixed, fixed_values, VecX::Constant(fixed_values.cols(), options.support_radius), options,
+                      report);
+}
+
+namespace {
+
+/// bounded_biharmonic_qp with a support radius per column (m; 0 = unrestricted).
+MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
+                  const BbwOptions& options, BbwReport* report) {
   const int n = mesh.num_nodes();
   require(fixed_values.rows() == fixed.size(), "bounded biharmonic weights: ", fixed.size(), " fixed nodes but ",
           fixed_values.rows(), " rows of fixed values");
@@ -357,6 +380,10 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
   // a nonzero value in the column; start radius from the volume per column.
   const double volume = fem::lumped_mass(mesh).sum();
   const double radius0 = options.initial_radius_factor * std::cbrt(volume / std::max(C, 1));
+  const bool compact = C > 0 && support_radius.maxCoeff() > 0.0;
+  const EdgeGraph graph = compact ? EdgeGraph(mesh) : EdgeGraph(TetMesh{});
+  std::vector<std::vector<char>> outside(compact ? C : 0);  // per column, #free
+  std::vector<int> support_nodes(compact ? C : 0, 0);
   const double t_setup = timer.seconds();
 
   timer.reset();
@@ -372,7 +399,19 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
         const Vec3 p = mesh.nodes.row(fixed(b)).transpose();
         for (int f = 0; f < nf; ++f) dist(f) = std::min(dist(f), (mesh.nodes.row(free_nodes[f]).transpose() - p).norm());
       }
-      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c);
+      if (compact && support_radius[c] > 0.0) {
+        std::vector<int> sources;
+        for (int b = 0; b < fixed.size(); ++b)
+          if (fixed_values(b, c) != 0.0) sources.push_back(fixed(b));
+        const VecX path = graph.distances(sources, support_radius[c]);
+        outside[c].assign(size_t(nf), 0);
+        for (int f = 0; f < nf; ++f) {
+          outside[c][f] = !(path(free_nodes[f]) <= support_radius[c]);
+          support_nodes[c] += !outside[c][f];
+        }
+      }
+      results[c] = solve_column(Qff, qcols.col(c), dist, radius0, options, c,
+                                outside.empty() || outside[c].empty() ? nullptr : &outside[c]);
       const int d = ++done;
       if (options.show_progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
@@ -439,11 +478,17 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
     for (int c = 0; c < C && nf > 0; ++c) {
       const VecX& x = results[c].x;
       const double qn = std::max(qcols.col(c).lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
-      r.kkt_residual = std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn));
+      r.kkt_residual =
+          std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn,
+                                                outside.empty() || outside[c].empty() ? nullptr : &outside[c]));
     }
+    r.support_radius = C > 0 ? support_radius.maxCoeff() : 0.0;
+    for (int sn : support_nodes) r.max_support_nodes = std::max(r.max_support_nodes, sn);
   }
   return W;
 }
+
+}  // namespace
 
 VecX bone_weight(const Eigen::SparseMatrix<double, Eigen::RowMajor>& W) {
   VecX s = W * VecX::Ones(W.cols());
@@ -486,9 +531,29 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> bounded_biharmonic_weights(const Te
   for (size_t b = 0; b < fixed.size(); ++b)
     if (value_col[b] >= 0) values(Eigen::Index(b), value_col[b]) = 1.0;
 
+  // Support radius of each handle (m; 0 = unrestricted).
+  require(options.support_radius >= 0.0 && std::isfinite(options.support_radius),
+          "bounded biharmonic weights: support radius must be a positive length in metres (or 0 for none), got ",
+          options.support_radius);
+  require(options.support_spacing_factor >= 0.0 && std::isfinite(options.support_spacing_factor),
+          "bounded biharmonic weights: support spacing factor must be positive (or 0 for none), got ",
+          options.support_spacing_factor);
+  require(!(options.support_radius > 0.0 && options.support_spacing_factor > 0.0),
+          "bounded biharmonic weights: give a support radius or a support spacing factor, not both");
+  VecX radius = VecX::Constant(K, options.support_radius);
+  if (options.support_spacing_factor > 0.0) {
+    require(K >= 2, "bounded biharmonic weights: a support spacing factor needs at least 2 handles, got ", K);
+    for (int k = 0; k < K; ++k) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int l = 0; l < K; ++l)
+        if (l != k) nearest = std::min(nearest, (mesh.nodes.row(handle_nodes(k)) - mesh.nodes.row(handle_nodes(l))).norm());
+      radius[k] = options.support_spacing_factor * nearest;
+    }
+  }
+
   BbwReport local;
   BbwReport& r = report ? *report : local;
-  MatX Wd = bounded_biharmonic_qp(mesh, fixed_v, values, options, &r);
+  MatX Wd = supported_qp(mesh, fixed_v, values, radius, options, &r);
 
   // Dirichlet: rescale rows with Σ_k w_k > 1. DepthBlend: every Simulated row
   // to b_i · w̃ / max(Σ w̃, floor), other rows 0 (see the header). Then sparsify.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -97,12 +98,21 @@ double reset_peak_rss_mib() {
   return kNaN;
 }
 
+/// CPU time of the calling thread (ms).
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
+}
+
 Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, double seconds, double h,
                   int newton_iters, const std::string& label, bool bones_dynamic = false,
                   bool mean_dilatation = SimulatorOptions().mean_dilatation,
-                  std::optional<double> nonlinearity_tolerance = std::nullopt) {
+                  std::optional<double> nonlinearity_tolerance = std::nullopt,
+                  LinearSolver linear_solver = LinearSolver::Dense, bool cpu_time = false) {
   const double rss0 = reset_peak_rss_mib();
   SimulatorOptions o;
+  o.newton.linear_solver = linear_solver;
   o.newton.nonlinearity_tolerance = nonlinearity_tolerance;
   o.mean_dilatation = mean_dilatation;
   o.h = h;
@@ -119,9 +129,11 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const MotionClip& motion
   Progress p("bench: " + label + (bones_dynamic ? " (dynamic bones)" : ""), steps);
   for (long s = 1; s <= steps; ++s) {
     const BodyPose pose = motion.sample(s * h);
+    const double cpu0 = thread_cpu_ms();
     const StepReport rep = sim.step(target_bones(*avatar, pose), pose);
+    const double cpu_ms = thread_cpu_ms() - cpu0;
     require(sim.state().z.allFinite(), "bench: ", label, " became non-finite at step ", s);
-    tr.ms.push_back(rep.ms_total);
+    tr.ms.push_back(cpu_time ? cpu_ms : rep.ms_total);
     for (const TermEnergy& e : rep.energies) {
       if (e.name == "inertia") tr.ms_inertia += e.ms;
       if (e.name == "elastic") tr.ms_elastic += e.ms;
@@ -347,7 +359,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     const std::string label = "K=" + std::to_string(K) + (what.empty() ? "" : ", " + what);
     if (!is_default && !wanted(label)) return;
     const Trace tr = run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, false, mean_dilatation,
-                                 nonlinearity_tolerance);
+                                 nonlinearity_tolerance, o.linear_solver, o.cpu_time);
     add(tr, a, "reduced", label, K, dt, iters, is_default);
     BenchRow& r = rows.back();
     const double steps = double(tr.ms.size());
@@ -357,7 +369,7 @@ std::vector<BenchRow> run_benchmark(const BenchOptions& in) {
     r.peak_mib = tr.peak_mib;
     r.dynamic_ms_median =
         percentile(run_reduced(a, motion, o.seconds, dt, iters, "reduced " + label, true, mean_dilatation,
-                               nonlinearity_tolerance)
+                               nonlinearity_tolerance, o.linear_solver, o.cpu_time)
                        .ms,
                    0.5);
   };

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "sflsh/basis/handle_placement.hpp"
+#include "sflsh/basis/sample_handles.hpp"
 #include "sflsh/mesh/tet_quality.hpp"
 
 namespace sflsh {
@@ -49,6 +50,10 @@ AvatarSummary summarize_avatar(const Avatar& a) {
         s.max_weight = std::max(s.max_weight, it.value());
       }
   }
+  if (a.W.rows() == s.tet_nodes && a.node_role.size() == s.tet_nodes) {
+    s.elastic_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.elastic);
+    s.inertia_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.inertia);
+  }
   s.region_names.clear();
   for (const RegionMaterial& m : a.materials) s.region_names.push_back(m.name);
   if (a.num_handles() > 0 && a.W.rows() == s.tet_nodes && a.tet_region.size() == s.tets) {
@@ -79,7 +84,9 @@ std::string AvatarSummary::to_text(const std::string& title) const {
     << "  basis             " << handles << " handles (" << 3 * handles << " reduced DoFs), " << basis_nonzeros
     << " non-zero weights in [" << min_weight << ", " << max_weight << "], max sum excess " << max_partition_error << "\n"
     << "  cubature          elastic " << elastic_samples << " samples (volume " << elastic_volume_m3 << " m^3), inertia "
-    << inertia_samples << " samples (volume " << inertia_volume_m3 << " m^3, mass " << inertia_mass_kg << " kg)\n";
+    << inertia_samples << " samples (volume " << inertia_volume_m3 << " m^3, mass " << inertia_mass_kg << " kg)\n"
+    << "  handles/sample    elastic mean " << elastic_handles.mean << ", max " << elastic_handles.max
+    << "; inertia mean " << inertia_handles.mean << ", max " << inertia_handles.max << "\n";
   if (coverage.skin_nodes > 0) {
     std::istringstream lines(coverage.describe(region_names));
     for (std::string line; std::getline(lines, line);) o << "  " << line << "\n";
@@ -104,6 +111,9 @@ std::string AvatarSummary::to_json() const {
     << "  \"inertia_mass_kg\": " << inertia_mass_kg << ",\n  \"max_partition_error\": " << max_partition_error << ",\n"
     << "  \"min_weight\": " << min_weight << ",\n  \"max_weight\": " << max_weight << ",\n"
     << "  \"height_m\": " << height_m << ",\n"
+    << "  \"handles_per_elastic_sample\": {\"mean\": " << elastic_handles.mean << ", \"max\": " << elastic_handles.max
+    << "},\n  \"handles_per_inertia_sample\": {\"mean\": " << inertia_handles.mean << ", \"max\": "
+    << inertia_handles.max << "},\n"
     << "  \"soft_coverage\": {\"threshold\": " << coverage.threshold << ", \"skin_nodes\": " << coverage.skin_nodes
     << ", \"covered\": " << coverage.covered << ", \"share\": " << coverage.share() << ", \"regions\": {";
   bool first = true;

@@ -1,5 +1,6 @@
 #include "sflsh/precompute/precompute.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/io/input_file.hpp"
+#include "sflsh/fem/tet_operators.hpp"
 
 namespace sflsh {
 
@@ -73,6 +75,23 @@ VecX tet_moduli(const Avatar& a) {
     E[t] = std::cbrt(m.young_along * m.young_through * m.young_around);
   }
   return E;
+}
+
+/// Regions the handle placement serves: those whose Simulated nodes hold at
+/// least `min_fraction` of the Simulated volume (basis::allocate_handles'
+/// threshold; the head's, hands' and feet's few Simulated border nodes fall
+/// below it).
+int simulated_region_count(const TemplateVolume& tv, double min_fraction) {
+  if (tv.tet_region.size() == 0) return 1;
+  const int R = 1 + tv.tet_region.maxCoeff();
+  const VecXi node_region = basis::node_regions_from_tets(tv.tet, tv.tet_region, R);
+  const VecX volume = fem::lumped_mass(tv.tet);
+  VecX per_region = VecX::Zero(R);
+  for (int i = 0; i < tv.tet.num_nodes(); ++i)
+    if (tv.node_role[i] == int(NodeRole::Simulated) && node_region[i] >= 0) per_region[node_region[i]] += volume[i];
+  int count = 0;
+  for (int r = 0; r < R; ++r) count += per_region[r] > 0.0 && per_region[r] >= min_fraction * per_region.sum();
+  return count;
 }
 
 }  // namespace
@@ -133,6 +152,21 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
   PrecomputeReport local;
   PrecomputeReport& r = report ? *report : local;
   Timer total;
+  require(options.bbw.support_radius >= 0.0 && std::isfinite(options.bbw.support_radius),
+          "precompute: support radius must be a positive length in metres (or 0 for none), got ",
+          options.bbw.support_radius);
+  require(options.bbw.support_spacing_factor >= 0.0 && std::isfinite(options.bbw.support_spacing_factor),
+          "precompute: support spacing factor must be positive (or 0 for none), got ",
+          options.bbw.support_spacing_factor);
+  if ((options.bbw.support_radius > 0.0 || options.bbw.support_spacing_factor > 0.0) &&
+      options.handle_positions.rows() == 0) {
+    // Compact supports reach only their own neighbourhood: a region without a
+    // handle would get no soft tissue at all.
+    const int regions = simulated_region_count(tv, options.placement.min_region_fraction);
+    require(options.handles >= regions, "precompute: --handles ", options.handles, " is below the ", regions,
+            " simulated regions; with compact supports (--support-radius, --support-spacing) every region needs a "
+            "handle");
+  }
 
   Timer t;
   ShapedVolume shaped = shape_volume(tv, model, betas, options.thickness, options.shape_stage);
@@ -178,6 +212,8 @@ Avatar precompute_shape(const TemplateVolume& tv, const BodyModel& model, const 
                                             options.inertia_samples_per_cell, &r.inertia_fit);
   r.elastic_errors = basis::cubature_errors(a.tet, a.elastic, rho);
   r.inertia_errors = basis::cubature_errors(a.tet, a.inertia, rho);
+  r.elastic_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.elastic);
+  r.inertia_handles = basis::handles_per_sample(a.tet, a.W, a.node_role, a.inertia);
   r.cubature_s = t.seconds();
   r.shape_stage_s = total.seconds();
   r.peak_rss_mib = peak_rss_mib();
@@ -234,6 +270,13 @@ std::string PrecomputeReport::describe() const {
     << " s, weights " << weights_s << " s, cubature " << cubature_s << " s), peak memory " << peak_rss_mib << " MiB\n";
   if (!template_from_cache) o << template_report.describe() << "\n";
   o << shape_report.describe() << "\n" << bbw_report.summary() << "\n";
+  if (bbw_report.support_radius > 0)
+    o << "compact support: largest radius " << bbw_report.support_radius << " m along the tet edges, largest support "
+      << bbw_report.max_support_nodes << " nodes\n";
+  for (const auto* h : {&elastic_handles, &inertia_handles})
+    if (h->samples > 0)
+      o << "handles per " << (h == &elastic_handles ? "elastic" : "inertia") << " sample: mean " << h->mean
+        << ", max " << h->max << " (" << h->samples << " samples)\n";
   // (coverage: printed by the avatar summary, see summarize_avatar.)
   o << std::setprecision(3);
   // CubatureErrors holds relative errors already.

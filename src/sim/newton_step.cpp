@@ -181,7 +181,15 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     ++rep.iterations;
 
     Timer ts;
-    solve_in_place(H, g, o.regularization, delta, &rep.regularization);
+    bool solved = false;
+    if (o.linear_solver == LinearSolver::Sparse) {
+      if (!sys.sparse_solver)
+        sys.sparse_solver = o.sparse_always ? std::make_shared<SparseHessianSolver>(1.0, 0.0)
+                                            : std::make_shared<SparseHessianSolver>();
+      solved = sys.sparse_solver->solve(H, g, delta);
+      if (solved) rep.regularization = 0.0, ++rep.sparse_solves;
+    }
+    if (!solved) solve_in_place(H, g, o.regularization, delta, &rep.regularization);
     rep.ms_solve += ts.ms();
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));

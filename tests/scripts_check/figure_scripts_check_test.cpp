@@ -37,6 +37,9 @@ std::string check_command(const std::string& kind, const std::string& dir) {
   if (kind == "teleop") return std::string(kPython) + " " + scripts + "teleop_figures.py --check " + dir;
   if (kind == "contact") return std::string(kPython) + " " + scripts + "contact_figures.py --check " + dir;
   if (kind == "fit") return std::string(kPython) + " " + scripts + "fit_benchmark.py --check " + dir;
+  if (kind == "sparse_subspace")
+    return std::string(kPython) + " " + scripts + "sparse_subspace.py --no-run --work " + dir + " --out " + dir +
+           "/sparse_subspace.md";
   if (kind == "batch_benchmark")
     return std::string(kPython) + " " + scripts + "batch_benchmark.py --check " + dir + "/checks.json";
   return "bash " + scripts + "batch_resume_check.sh --check " + dir + "/figures.txt";
@@ -126,6 +129,13 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"batch_benchmark", "template_rewritten", 1, {"the template cache entry was rewritten"}},
         Case{"batch_benchmark", "missing_field", 2, {"checks.json: field 'template_cache_rewritten' missing"}},
         Case{"batch_benchmark", "malformed", 2, {"checks.json: not JSON"}}),
+    name_of);
+
+INSTANTIATE_TEST_SUITE_P(
+    SparseSubspace, FigureScriptCheck,
+    ::testing::Values(Case{"sparse_subspace", "good", 0, {"Verdict: met by a compact-support row"}},
+                      Case{"sparse_subspace", "slow", 1, {"**missed** by every compact-support row", "dynamic **no**"}},
+                      Case{"sparse_subspace", "no_column", 2, {"t4_sp25_sparse/bench.csv: column rel_err_forearm"}}),
     name_of);
 
 }  // namespace

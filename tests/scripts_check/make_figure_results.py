@@ -3,7 +3,7 @@
 
   make_figure_results.py KIND VARIANT DIR
 
-KIND: teleop | contact | fit | batch_resume | batch_benchmark. VARIANT "good" writes files that
+KIND: teleop | contact | fit | batch_resume | batch_benchmark | sparse_subspace. VARIANT "good" writes files that
 meet every target the script states (values near the recorded figures);
 every other variant is "good" with one defect (see VARIANTS), either a missed
 target (the script must exit 1) or a missing/malformed file, column or line
@@ -229,8 +229,39 @@ def batch_benchmark(variant, d):
     write(os.path.join(d, "checks.json"), text)
 
 
+SPARSE_CONFIGS = [("t1_default", False, [96, 192]), ("t2_cs15_sparse", True, [96, 192, 288]),
+                  ("t3_cs15_dense", True, [96, 192, 288]), ("t4_sp25_sparse", True, [96, 192, 288]),
+                  ("t5_sp20_480_sparse", True, [96, 480]), ("t6_sp20_480_dense", True, [96, 480])]
+
+
+def sparse_subspace(variant, d):
+    """`sflsh bench` folders for scripts/sparse_subspace.py. good: every row meets the four targets
+    (regions <= 0.35, overall <= 0.12, dynamic <= 0.6 ms, prescribed <= 0.4 ms); slow: the compact
+    rows' dynamic-bone step is 0.9 ms (missed, exit 1); no_column: t4's CSV lacks rel_err_forearm (exit 2)."""
+    base = ["method", "handles", "dt", "newton_iters", "is_default", "ms_median", "ms_p95", "speedup", "err_mean_mm",
+            "err_max_mm", "rel_err", "peak_ratio", "floor_rel_err", "ms_inertia", "ms_elastic", "ms_solve",
+            "dynamic_ms_median", "peak_mib"]
+    for name, compact, ks in SPARSE_CONFIGS:
+        os.makedirs(os.path.join(d, name), exist_ok=True)
+        header = base + [f"{p}_{g}" for g in REGIONS for p in ("rel_err", "floor")]
+        if variant == "no_column" and name == "t4_sp25_sparse":
+            header.remove("rel_err_forearm")
+        with open(os.path.join(d, name, "bench.csv"), "w", newline="") as f:
+            w = csv.writer(f, lineterminator="\n")
+            w.writerow(header)
+            w.writerow({"method": "reference"}.get(c, 0) for c in header)
+            for k in ks:
+                dyn = 0.9 if variant == "slow" and compact else 0.5
+                r = {"method": "reduced", "handles": k, "dt": 1 / 60, "newton_iters": 1, "is_default": int(k == 96),
+                     "ms_median": 0.3, "dynamic_ms_median": dyn, "rel_err": 0.11, "floor_rel_err": 0.06,
+                     "ms_inertia": 0.05, "ms_elastic": 0.1, "ms_solve": 0.1}
+                for g in REGIONS:
+                    r["rel_err_" + g], r["floor_" + g] = 0.3, 0.2
+                w.writerow(r.get(c, 0) for c in header)
+
+
 KINDS = {"teleop": teleop, "contact": contact, "fit": fit, "batch_resume": batch_resume,
-         "batch_benchmark": batch_benchmark}
+         "batch_benchmark": batch_benchmark, "sparse_subspace": sparse_subspace}
 
 
 def main():

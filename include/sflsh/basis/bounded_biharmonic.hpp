@@ -110,6 +110,24 @@ struct BbwOptions {
   /// factorization before the inactive block is refactored; 0 refactors every
   /// iteration. A border column costs about 1/100 of a factorization.
   int max_border_columns = 200;
+  /// Compact support (m; 0 = off, the default). When positive, column k is
+  /// the bounded biharmonic function restricted to its support: the nodes
+  /// whose shortest path along tet edges to the column's nonzero fixed nodes
+  /// (handle k) is at most this long. Every node outside is held at 0 like a
+  /// Dirichlet node. Because Q = L M⁻¹ L also carries the Laplacian rows of
+  /// the held nodes next to the support, the minimizer meets 0 with zero slope
+  /// there (C¹, no crease): in 1-D, a handle at c with radius r gets
+  /// 1 − 3s² + 2s³, s = |x − c| / r. The weight is exactly 0 outside the support,
+  /// so a cubature sample sees only the handles within this distance.
+  /// Negative or NaN: an error.
+  double support_radius = 0.0;
+  /// Compact support sized by the handle spacing (bounded_biharmonic_weights
+  /// only; 0 = off, the default): handle k's radius is this times the
+  /// distance from its node to the nearest other handle's node, so sparse
+  /// handles (limbs) get wide supports and dense ones (trunk) narrow ones,
+  /// and the handles per cubature sample stay about even. Exclusive with
+  /// support_radius. Negative or NaN: an error.
+  double support_spacing_factor = 0.0;
   /// Show a progress line (sflsh::Progress) over handles.
   bool show_progress = true;
   /// Threads that solve the columns (each column on one thread; the result
@@ -139,6 +157,8 @@ struct BbwReport {
   int nodes_normalized = 0;          ///< rows rescaled (Dirichlet: Σ_k w_k > 1; DepthBlend: every reached Simulated row)
   int nodes_unreached = 0;           ///< DepthBlend: Simulated rows with Σ_k w̃_k < normalization_floor
   long nonzeros = 0;                 ///< stored entries of W
+  double support_radius = 0.0;       ///< largest support radius used (m; 0 = unrestricted)
+  int max_support_nodes = 0;         ///< support_radius > 0: largest support (free nodes inside), over columns
   double seconds_setup = 0.0, seconds_active_set = 0.0;  ///< operators; all QPs
   /// Multi-line human-readable summary.
   std::string summary() const;

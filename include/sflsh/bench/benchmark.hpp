@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "sflsh/precompute/precompute.hpp"
+#include "sflsh/sim/newton_step.hpp"
 
 namespace sflsh {
 
@@ -35,6 +36,12 @@ struct BenchOptions {
   double default_dt = 1.0 / 60.0;
   int converged_newton_iters = 20;        ///< the "Newton to convergence" variant
   PrecomputeOptions precompute;           ///< template/shape options (cache dir, ...)
+  /// Factorization of the reduced rows' Newton systems (the full-FEM reference keeps CHOLMOD).
+  LinearSolver linear_solver = LinearSolver::Dense;
+  /// Reduced rows' ms per step (ms_median, p95, dynamic bones) as the stepping
+  /// thread's CPU time instead of wall time: on a machine shared with other
+  /// jobs it leaves out the time the thread waits for a core.
+  bool cpu_time = false;
   /// Run only the variants whose label contains one of these strings (case
   /// sensitive); the reference, the default and skinning always run. Empty: all.
   std::vector<std::string> only;

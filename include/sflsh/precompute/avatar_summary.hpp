@@ -6,6 +6,7 @@
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/basis/basis_coverage.hpp"
+#include "sflsh/basis/sample_handles.hpp"
 
 namespace sflsh {
 
@@ -23,6 +24,8 @@ struct AvatarSummary {
   double inertia_mass_kg = 0;      ///< Σ ρ c_s over inertia samples
   double max_partition_error = 0;  ///< max over simulated nodes of (Σ_k W_nk − 1) if > 0 (must be ≤ 0)
   double min_weight = 0, max_weight = 0;
+  /// Handles with a nonzero weight at each cubature sample (basis/sample_handles.hpp).
+  basis::SampleHandleCounts elastic_handles, inertia_handles;
   double height_m = 0;
   /// Handles per region (by material name) and share of simulated skin nodes
   /// (outer surface, role Simulated) with Σ_k W_k ≥ 0.5.

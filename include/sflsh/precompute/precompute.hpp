@@ -13,6 +13,7 @@
 #include "sflsh/basis/cubature.hpp"
 #include "sflsh/basis/handle_placement.hpp"
 #include "sflsh/basis/mass_fitted_cubature.hpp"
+#include "sflsh/basis/sample_handles.hpp"
 #include "sflsh/basis/stiffness_fitted_cubature.hpp"
 #include "sflsh/body/body_model.hpp"
 #include "sflsh/volume/shape_volume.hpp"
@@ -62,6 +63,7 @@ struct PrecomputeReport {
   basis::BasisCoverage coverage;
   std::vector<std::string> region_names;  ///< #R, for coverage.describe
   basis::CubatureErrors elastic_errors, inertia_errors;
+  basis::SampleHandleCounts elastic_handles, inertia_handles;  ///< handles per cubature sample
   basis::FittedCubatureReport elastic_fit;  ///< valid when options.fit_elastic_cubature
   basis::MassFitReport inertia_fit;         ///< valid when options.inertia_samples_per_cell > 0
   double template_s = 0, shape_geometry_s = 0, handles_s = 0, weights_s = 0, cubature_s = 0;

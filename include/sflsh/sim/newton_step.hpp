@@ -3,16 +3,28 @@
 // (Gast et al. 2015; seed §1): dense assembly over the DofLayout, Cholesky of
 // the PSD Hessian (+ a relative diagonal shift only if it does not factor), step in
 // the tangent space, retraction (configuration.hpp).
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/sparse_hessian_solve.hpp"
 #include "sflsh/sim/step_report.hpp"
 
 namespace sflsh {
 
 /// NewtonOptions::nonlinearity_tolerance when unset and every DoF is soft tissue.
 constexpr double kAutoNonlinearityTolerance = 0.05;
+
+/// How the Newton system H δ = −g is factored.
+enum class LinearSolver {
+  Dense,  ///< Cholesky of the dense H (the default)
+  /// Sparse LDLᵀ of H's nonzero pattern, analysed once per system
+  /// (sim/sparse_hessian_solve.hpp); pays with compactly supported handle
+  /// weights. Falls back to Dense for a step whose pattern is too dense or
+  /// whose H does not factor without a shift.
+  Sparse,
+};
 
 struct NewtonOptions {
   /// Newton iterations per time step (1 = the paper's default).
@@ -67,6 +79,11 @@ struct NewtonOptions {
   /// then H_ii ← H_ii (1 + ε), ε = this, multiplied by 100 (up to 6 times)
   /// until it factors. Relative per entry, so light DoFs are not biased.
   double regularization = 1e-10;
+  /// Factorization of the Newton system (LinearSolver).
+  LinearSolver linear_solver = LinearSolver::Dense;
+  /// LinearSolver::Sparse: factor sparsely whatever the pattern's density and
+  /// cost (tests of the sparse path on bodies too small for it to pay).
+  bool sparse_always = false;
   /// Evaluate energy and gradient at the final configuration for the report
   /// (costs one gradient evaluation; needed for energy_after/grad_norm_after).
   bool report_final = true;
@@ -101,6 +118,8 @@ struct StepSystem {
   int size = 0;                   ///< global step vector size
   VecX scratch_grad;              ///< scratch of scattered terms (reused)
   MatX scratch_hess;
+  /// LinearSolver::Sparse: the analysed pattern, kept across steps (created on first use).
+  std::shared_ptr<SparseHessianSolver> sparse_solver;
 };
 
 /// Σ active terms at q (one Configuration per body), adding gradient/Hessian

@@ -44,6 +44,7 @@ struct StepReport {
   double step_scale = 1;              ///< scale applied to the last Newton step (1 = full)
   double regularization = 0;          ///< relative diagonal shift ε of the last solve (H_ii(1 + ε); 0 = none)
   int iterations = 0;                 ///< Newton iterations performed
+  int sparse_solves = 0;              ///< of those, solved by the sparse factorization (NewtonOptions::linear_solver)
   int accepted = 0, damped = 0, rejected = 0;  ///< per-iteration outcome counts
   /// Of `iterations`, those added because the planned last one was damped
   /// (NewtonOptions::iterations_after_damping).

@@ -57,14 +57,25 @@ ElasticTerm::ElasticTerm(const Avatar& a, bool project_psd, bool exact_quadratic
     material_.emplace_back(tet_material(a, t), tet_frame(a, t));
     linear_hessian_.push_back(linearized_hessian(material_.back()));
   }
-  if (!exact_quadratic_) return;
-  // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
-  K_ = linearized_stiffness(a, material_tet_stiffness(a), mean_dilatation_);
   const int nh = num_reduced_ / 3;
-  K_blocks_.assign(size_t(9) * nh * nh, 0.0);
+  std::vector<char> used(size_t(nh) * nh, 0);  // upper block (i, j) at nh * j + i
+  for (int k = 0; k < cub.size(); ++k)
+    for (int e = start_[k]; e < start_[k + 1]; ++e)
+      for (int f = start_[k]; f < start_[k + 1]; ++f)
+        if (handle_[e] <= handle_[f]) used[size_t(nh) * handle_[f] + handle_[e]] = 1;
+  if (exact_quadratic_) {
+    // ½ zᵀ K z: the linearized energy integrated over every tet that moves.
+    K_ = linearized_stiffness(a, material_tet_stiffness(a), mean_dilatation_);
+    K_blocks_.assign(size_t(9) * nh * nh, 0.0);
+    for (int j = 0; j < nh; ++j)
+      for (int i = 0; i <= j; ++i) {
+        Eigen::Map<Mat3>(K_blocks_.data() + 9 * (size_t(nh) * j + i)) = K_.block<3, 3>(3 * i, 3 * j);
+        if (!K_.block<3, 3>(3 * i, 3 * j).isZero(0.0)) used[size_t(nh) * j + i] = 1;
+      }
+  }
   for (int j = 0; j < nh; ++j)
     for (int i = 0; i <= j; ++i)
-      Eigen::Map<Mat3>(K_blocks_.data() + 9 * (size_t(nh) * j + i)) = K_.block<3, 3>(3 * i, 3 * j);
+      if (used[size_t(nh) * j + i]) blocks_used_.emplace_back(i, j);
 }
 
 Mat3 ElasticTerm::deformation_gradient(int k, const VecX& z) const {
@@ -101,10 +112,13 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
   const int K = num_reduced_ / 3;
   if (hess) {
     // Only the upper blocks are accumulated; ½ zᵀ K z's Hessian K starts them.
-    if (exact_quadratic_)
-      c.blocks = K_blocks_;
-    else
-      c.blocks.assign(size_t(9) * K * K, 0.0);
+    // Blocks outside blocks_used_ are 0 in K and never written by a sample:
+    // they are zeroed once, and only the used ones are reset afterwards.
+    if (c.blocks.size() != size_t(9) * K * K) c.blocks.assign(size_t(9) * K * K, 0.0);
+    for (const auto& [i, j] : blocks_used_) {
+      const size_t b = 9 * (size_t(K) * j + i);
+      for (int v = 0; v < 9; ++v) c.blocks[b + v] = exact_quadratic_ ? K_blocks_[b + v] : 0.0;
+    }
   }
   double E = 0;
   for (int k = 0; k < S; ++k) {
@@ -139,7 +153,7 @@ double ElasticTerm::compute(const StepContext& ctx, const Configuration& q, VecR
     E += 0.5 * q.z.dot(Kz);
     if (grad) grad->segment(z0, num_reduced_) += Kz;
   }
-  if (hess) add_hessian_blocks(c.blocks.data(), K, z0, *hess);
+  if (hess) add_hessian_blocks(c.blocks.data(), K, blocks_used_, z0, *hess);
   return E;
 }
 

@@ -10,6 +10,7 @@
 // the sample's handles (~27 m² flops for m handles, no dense 9 by 3m product),
 // into a scratch of the upper 3x3 blocks (9 contiguous doubles each; started
 // at K for exact_quadratic) that is added to both triangles of the Hessian at the end.
+#include <utility>
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
@@ -54,6 +55,10 @@ class ElasticTerm : public EnergyTerm {
   std::vector<Mat9> linear_hessian_;    // #S ∂²Ψ₂/∂F² of the sample's material
   MatX K_;                              // 3K x 3K exact linearized stiffness (exact_quadratic)
   std::vector<double> K_blocks_;        // K_'s upper 3x3 blocks (sample_hessian.hpp layout)
+  // The upper 3x3 blocks (i <= j) that can be nonzero: K_'s nonzero blocks and
+  // every pair of handles sharing a sample. Only these are reset and added to
+  // the Hessian (the others stay 0: with compactly supported weights most are).
+  std::vector<std::pair<int, int>> blocks_used_;
   std::vector<int> start_{0}, handle_;  // CSR over samples: handles touching the tet
   std::vector<Vec3> d_;                 // per entry: ∂u/∂x̄ per unit z_h (1/m)
   int num_reduced_ = 0;

@@ -3,6 +3,7 @@
 // sample's F depends on the handles touching its tet (elastic.hpp), so
 //   hess(z-block) += Gᵀ Hw G,   G(a + 3b, 3e + c) = δ_ac d_e[b]   (G = ∂vec(F)/∂z).
 // Shared by the elastic term and its parameter sensitivities (elastic_sensitivity.hpp).
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -62,6 +63,25 @@ inline void add_sample_hessian_blocks(const Eigen::Matrix<double, 9, 9>& Hw, con
       else
         Eigen::Map<Mat3>(blocks + 9 * (size_t(K) * he + hf)) += block.transpose();
     }
+  }
+}
+
+/// add_hessian_blocks restricted to the upper blocks (i, j), i <= j, listed in
+/// `used` (the others must be 0): the same sums, in the same order per entry.
+inline void add_hessian_blocks(const double* blocks, int K, const std::vector<std::pair<int, int>>& used, int z0,
+                               Eigen::Ref<MatX> hess) {
+  for (const auto& [i, j] : used) {
+    const Eigen::Map<const Mat3> B(blocks + 9 * (size_t(K) * j + i));
+    if (i != j) {
+      hess.block<3, 3>(z0 + 3 * i, z0 + 3 * j) += B;
+      hess.block<3, 3>(z0 + 3 * j, z0 + 3 * i) += B.transpose();
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a <= c; ++a) {
+        hess(z0 + 3 * j + a, z0 + 3 * j + c) += B(a, c);
+        if (a != c) hess(z0 + 3 * j + c, z0 + 3 * j + a) += B(a, c);
+      }
   }
 }
 
