@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "command.hpp"
+#include "support_flags.hpp"
 #include "sflsh/core/error.hpp"
 #include "sflsh/bench/benchmark.hpp"
 #include "sflsh/io/atomic_output.hpp"
@@ -45,21 +46,7 @@ void run_bench(const BenchArgs& a) {
   require(a.inertia_samples_per_cell >= 0 && a.inertia_samples_per_cell <= 1000,
           "--inertia-samples-per-cell must be in [0, 1000], got ", a.inertia_samples_per_cell);
   o.precompute.inertia_samples_per_cell = a.inertia_samples_per_cell;
-  if (!a.support_radius.empty()) {
-    char* end = nullptr;
-    const double r = std::strtod(a.support_radius.c_str(), &end);
-    require(end != a.support_radius.c_str() && *end == '\0' && std::isfinite(r) && r > 0 && r <= 10,
-            "--support-radius must be a length in (0, 10] m, got '", a.support_radius, "'");
-    o.precompute.bbw.support_radius = r;
-  }
-  if (!a.support_spacing.empty()) {
-    char* end = nullptr;
-    const double f = std::strtod(a.support_spacing.c_str(), &end);
-    require(end != a.support_spacing.c_str() && *end == '\0' && std::isfinite(f) && f > 0 && f <= 100,
-            "--support-spacing must be a factor in (0, 100], got '", a.support_spacing, "'");
-    require(a.support_radius.empty(), "--support-spacing and --support-radius exclude each other");
-    o.precompute.bbw.support_spacing_factor = f;
-  }
+  apply_support_flags(a.support_radius, a.support_spacing, o.precompute.bbw);
   require(a.linear_solver == "dense" || a.linear_solver == "sparse", "--linear-solver must be dense or sparse, got '",
           a.linear_solver, "'");
   o.linear_solver = a.linear_solver == "sparse" ? LinearSolver::Sparse : LinearSolver::Dense;

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "command.hpp"
+#include "support_flags.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
 #include "sflsh/mesh/tet_topology_hash.hpp"
@@ -71,21 +72,7 @@ PrecomputeOptions make_options(const PrecomputeArgs& a) {
   if (a.facet_distance > 0) o.template_stage.mesh.facet_distance = a.facet_distance;
   require(a.threads >= 0 && a.threads <= 1024, "--threads must be in [1, 1024] (or 0 for all cores), got ", a.threads);
   o.bbw.threads = a.threads;
-  if (!a.support_radius.empty()) {
-    char* end = nullptr;
-    const double r = std::strtod(a.support_radius.c_str(), &end);
-    require(end != a.support_radius.c_str() && *end == '\0' && std::isfinite(r) && r > 0 && r <= 10,
-            "--support-radius must be a length in (0, 10] m, got '", a.support_radius, "'");
-    o.bbw.support_radius = r;
-  }
-  if (!a.support_spacing.empty()) {
-    char* end = nullptr;
-    const double f = std::strtod(a.support_spacing.c_str(), &end);
-    require(end != a.support_spacing.c_str() && *end == '\0' && std::isfinite(f) && f > 0 && f <= 100,
-            "--support-spacing must be a factor in (0, 100], got '", a.support_spacing, "'");
-    require(a.support_radius.empty(), "--support-spacing and --support-radius exclude each other");
-    o.bbw.support_spacing_factor = f;
-  }
+  apply_support_flags(a.support_radius, a.support_spacing, o.bbw);
   return o;
 }
 

@@ -36,6 +36,7 @@ std::string check_command(const std::string& kind, const std::string& dir) {
   const std::string scripts = test::source_dir() + "/scripts/";
   if (kind == "teleop") return std::string(kPython) + " " + scripts + "teleop_figures.py --check " + dir;
   if (kind == "contact") return std::string(kPython) + " " + scripts + "contact_figures.py --check " + dir;
+  if (kind == "patch_stress") return std::string(kPython) + " " + scripts + "patch_stress.py --check " + dir;
   if (kind == "fit") return std::string(kPython) + " " + scripts + "fit_benchmark.py --check " + dir;
   if (kind == "sparse_subspace")
     return std::string(kPython) + " " + scripts + "sparse_subspace.py --no-run --work " + dir + " --out " + dir +
@@ -68,7 +69,7 @@ TEST_P(FigureScriptCheck, JudgesTheCraftedFolder) {
     EXPECT_EQ(out.find("| figure |"), std::string::npos) << out;
   }
   if (c.exit_code == 0) EXPECT_EQ(out.find("**no**"), std::string::npos) << out;
-  if (c.exit_code == 1 && (c.kind == "teleop" || c.kind == "contact"))  // the table is printed, the row marked
+  if (c.exit_code == 1 && (c.kind == "teleop" || c.kind == "contact" || c.kind == "patch_stress"))  // the table is printed, the row marked
     EXPECT_NE(out.find("**no**"), std::string::npos) << out;
 }
 
@@ -129,6 +130,15 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"batch_benchmark", "template_rewritten", 1, {"the template cache entry was rewritten"}},
         Case{"batch_benchmark", "missing_field", 2, {"checks.json: field 'template_cache_rewritten' missing"}},
         Case{"batch_benchmark", "malformed", 2, {"checks.json: not JSON"}}),
+    name_of);
+
+INSTANTIATE_TEST_SUITE_P(
+    PatchStress, FigureScriptCheck,
+    ::testing::Values(Case{"patch_stress", "good", 0, {"| 10000 / 0 | yes", "0.4520 J / 0.4500 J | yes"}},
+                      Case{"patch_stress", "runaway", 1, {"target missed: elastic energy: largest over the run",
+                                                          "78000.000 J"}},
+                      Case{"patch_stress", "rejected", 1, {"target missed: steps taken / rejected: 10000 / 1"}},
+                      Case{"patch_stress", "no_energy", 2, {"tools.csv: column 'elastic_energy' missing"}}),
     name_of);
 
 INSTANTIATE_TEST_SUITE_P(

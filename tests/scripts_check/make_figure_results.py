@@ -260,8 +260,30 @@ def sparse_subspace(variant, d):
                 w.writerow(r.get(c, 0) for c in header)
 
 
+def patch_stress(variant, d):
+    """scripts/patch_stress.py's folder (run.log, tools.csv). good: 10,000 steps, the energy 0.45 J at rest, 1.2 J
+    at most, back to 0.452 J; runaway: it reaches 7.8e4 J and stays (exit 1); rejected: one rejected step (exit 1);
+    no_energy: tools.csv lacks elastic_energy (exit 2)."""
+    rejected = 1 if variant == "rejected" else 0
+    write(os.path.join(d, "run.log"),
+          "as fast as possible: simulated 20.000 s in 195.454 s of wall time (10000 steps), RTF 0.102\n" +
+          steps_line(10000, rejected))
+    t = np.arange(0, 10001) / 500.0
+    energy = 0.45 + 0.75 * ((t >= 10) & (t < 19)) * np.abs(np.sin(2 * np.pi * t))
+    energy[-1] = 0.452
+    if variant == "runaway":
+        energy[t >= 10.3] = 7.8e4
+    header = ["time", "tool", "force_x", "force_y", "force_z"] + ([] if variant == "no_energy" else ["elastic_energy"])
+    with open(os.path.join(d, "tools.csv"), "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(header)
+        for i in range(t.size):
+            row = [f"{t[i]:.3f}", "probe", 0.0, 0.0, 3.0 if t[i] < 10 else 12.0, energy[i]]
+            w.writerow(row[:len(header)])
+
+
 KINDS = {"teleop": teleop, "contact": contact, "fit": fit, "batch_resume": batch_resume,
-         "batch_benchmark": batch_benchmark, "sparse_subspace": sparse_subspace}
+         "batch_benchmark": batch_benchmark, "sparse_subspace": sparse_subspace, "patch_stress": patch_stress}
 
 
 def main():
