@@ -9,8 +9,9 @@ all the time:
     out every 0.5 s (and pushed back in, through the skin in one step),
   * 19-20 s it is away again.
 Targets: every step taken (10,000), none rejected, every logged value finite,
-the elastic energy bounded (at most MAX_ENERGY J at any time) and back to rest
-at the end (within REST_TOLERANCE of its value at 1 s).
+the elastic energy bounded (at most MAX_ENERGY J at any time) and, with the
+probe away at the end, no higher than before the first contact (1 s; the body
+is still settling from its sag then) by more than REST_TOLERANCE.
 
 The run's log and tool log stay in WORK_DIR; the verdicts are computed from
 those files alone, so `--check WORK_DIR` re-judges a finished run. Writes a
@@ -114,8 +115,8 @@ def judge(work):
     tab.row("every logged value finite", "yes", "yes" if finite else "no", finite, scene)
     tab.row("elastic energy: largest over the run", f"≤ {MAX_ENERGY:g} J", f"{np.max(e):.3f} J",
             bool(np.max(e) <= MAX_ENERGY), scene)
-    tab.row("elastic energy at the end against at rest (1 s)", f"within {REST_TOLERANCE:.0%}",
-            f"{end:.4f} J / {rest:.4f} J", bool(abs(end - rest) <= REST_TOLERANCE * rest), scene)
+    tab.row("elastic energy at the end (probe away) against before the first contact (1 s)",
+            f"≤ {1 + REST_TOLERANCE:g} ×", f"{end:.4f} J / {rest:.4f} J", bool(end <= (1 + REST_TOLERANCE) * rest), scene)
     tab.row("probe force: largest while tapping / yanking", "(record)",
             f"{tapping.max():.1f} N / {yanking.max():.1f} N", None, scene)
     tab.row("step time median / p99 (one core)", "(record)", f"{float(m[4]):.2f} / {float(m[5]):.2f} ms", None,

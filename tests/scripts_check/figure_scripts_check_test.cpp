@@ -137,6 +137,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{"patch_stress", "good", 0, {"| 10000 / 0 | yes", "0.4520 J / 0.4500 J | yes"}},
                       Case{"patch_stress", "runaway", 1, {"target missed: elastic energy: largest over the run",
                                                           "78000.000 J"}},
+                      Case{"patch_stress", "not_back", 1, {"target missed: elastic energy at the end (probe away)",
+                                                           "0.6000 J / 0.4500 J"}},
                       Case{"patch_stress", "rejected", 1, {"target missed: steps taken / rejected: 10000 / 1"}},
                       Case{"patch_stress", "no_energy", 2, {"tools.csv: column 'elastic_energy' missing"}}),
     name_of);

@@ -262,7 +262,8 @@ def sparse_subspace(variant, d):
 
 def patch_stress(variant, d):
     """scripts/patch_stress.py's folder (run.log, tools.csv). good: 10,000 steps, the energy 0.45 J at rest, 1.2 J
-    at most, back to 0.452 J; runaway: it reaches 7.8e4 J and stays (exit 1); rejected: one rejected step (exit 1);
+    at most, back to 0.452 J; runaway: it reaches 7.8e4 J and stays (exit 1); not_back: it ends at 0.6 J (exit 1);
+    rejected: one rejected step (exit 1);
     no_energy: tools.csv lacks elastic_energy (exit 2)."""
     rejected = 1 if variant == "rejected" else 0
     write(os.path.join(d, "run.log"),
@@ -270,7 +271,7 @@ def patch_stress(variant, d):
           steps_line(10000, rejected))
     t = np.arange(0, 10001) / 500.0
     energy = 0.45 + 0.75 * ((t >= 10) & (t < 19)) * np.abs(np.sin(2 * np.pi * t))
-    energy[-1] = 0.452
+    energy[-1] = 0.6 if variant == "not_back" else 0.452
     if variant == "runaway":
         energy[t >= 10.3] = 7.8e4
     header = ["time", "tool", "force_x", "force_y", "force_z"] + ([] if variant == "no_energy" else ["elastic_energy"])
