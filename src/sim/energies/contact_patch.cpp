@@ -25,7 +25,7 @@ struct ContactPatchTerm::Evaluation {
   VecX gp;   // ∂Φ/∂δu
   MatX Hpp;  // its PSD approximation
   VecX gq;   // ∂Φ/∂q
-  MatX Hqq;  // Gauss–Newton contact block
+  MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
   MatX Hqp;  // cross block (layout rows by patch DoFs)
   MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q derivatives)
   Vec3 force = Vec3::Zero();
