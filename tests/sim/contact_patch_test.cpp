@@ -134,6 +134,13 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
     }
     EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "bones dynamic " << dynamic << ", " << press << " m: |g| " << g.norm()
                                                   << ", |fd| " << fd.norm();
+    // The gradient asked with the Hessian (the Newton iteration) is the one
+    // asked alone (the final report), back to back at one q (one minimizer).
+    VecX g_alone = VecX::Zero(n), g_with_hessian = VecX::Zero(n);
+    MatX H_unused = MatX::Zero(n, n);
+    term.evaluate(ctx, q, &g_alone, nullptr);
+    term.evaluate(ctx, q, &g_with_hessian, &H_unused);
+    EXPECT_LT((g_with_hessian - g_alone).norm(), 1e-13 * g_alone.norm()) << "the gradient with and without the Hessian";
     // The term alone subtracts the subspace's stiffness of the patch's tets
     // (the patch takes their load): with the subspace's own elasticity and
     // inertia, the step's Hessian is positive semi-definite at small strain
@@ -393,6 +400,15 @@ TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFinit
   ctx.bound[0].q = &q;
   ctx.bound[1].q = &ball;
   EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "|g| " << g.norm() << ", |fd| " << fd.norm();
+  // The gradient asked with the Hessian (the Newton iteration) is the one asked
+  // alone (the final report): the gradient-only evaluation skips only Hessian work.
+  // (Asked back to back at one q, both see the same minimizer.)
+  VecX g_alone = VecX::Zero(n), g_with_hessian = VecX::Zero(n);
+  MatX H = MatX::Zero(n, n);
+  term.evaluate(ctx, q, &g_alone, nullptr);
+  term.evaluate(ctx, q, &g_with_hessian, &H);
+  EXPECT_LT((g_with_hessian - g_alone).norm(), 1e-13 * g_alone.norm());
+  EXPECT_GT(H.norm(), 0);
   // The ball's generalized force is the reaction of the contact force on the body: −f along v.
   const auto r = term.report(ctx, q);
   const Vec3 f(quantity(r, "force", 0), quantity(r, "force", 1), quantity(r, "force", 2));

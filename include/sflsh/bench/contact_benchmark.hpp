@@ -75,6 +75,9 @@ struct ContactBenchSettings {
   bool patch = true;
   double patch_radius = ContactPatchOptions().patch_radius;
   std::vector<std::string> scenes;   ///< which scenes to run (empty: pressed, impact, probe)
+  /// The ms columns: the stepping thread's CPU time instead of wall time (on a
+  /// shared machine other jobs' load inflates wall time, not CPU time).
+  bool cpu_time = false;
 };
 
 struct ContactBenchOptions {

@@ -1,4 +1,6 @@
 #pragma once
+#include <time.h>
+
 #include <chrono>
 
 namespace sflsh {
@@ -16,5 +18,13 @@ class Timer {
  private:
   std::chrono::steady_clock::time_point start_;
 };
+
+/// CPU time of the calling thread (ms): what a benchmark on a shared machine
+/// reports when other jobs' load would inflate wall time.
+inline double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
+}
 
 }  // namespace sflsh

@@ -137,13 +137,24 @@ class ContactPatchTerm : public EnergyTerm {
 
  private:
   struct EvaluationMode {
-    bool q_derivatives = false;   ///< ∂Φ/∂q, Φ_qq and Φ_qp
+    bool q_derivatives = false;   ///< ∂Φ/∂q
+    bool q_hessian = false;       ///< with q_derivatives: also Φ_qq, Φ_qp and K0_pp
     bool p_derivatives = true;    ///< ∂Φ/∂δu and Φ_pp
     bool project = true;          ///< PSD-projected element Hessians (else exact)
     bool subspace_energy = true;  ///< include −Σ V Ψ(F(Wz)) (constant in δu)
   };
   double evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
                         Evaluation& out) const;
+  // Its parts (contact_patch_evaluation.cpp), each adding to `out` and returning its energy:
+  // the patch nodes' inertia and gravity less the inertia samples the subspace holds there,
+  double add_patch_inertia(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
+                           Evaluation& out) const;
+  // the patch tets' elasticity less what the subspace's elastic term holds of them (+inf if one inverts),
+  double add_patch_elasticity(const StepContext& ctx, const Configuration& q, const VecX& du,
+                              const EvaluationMode& mode, Evaluation& out) const;
+  // the contact over the candidate faces' samples.
+  double add_patch_contact(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
+                           Evaluation& out) const;
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
   /// What the subspace's elastic term holds of tet `t` per unit volume at F

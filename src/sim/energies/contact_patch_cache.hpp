@@ -1,0 +1,92 @@
+#pragma once
+// Private to contact_patch*.cpp: the term's per-step cache and one evaluation
+// of Φ and its derivatives (contact_patch.hpp's header comment).
+#include <array>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
+
+namespace sflsh {
+
+/// Φ and its derivatives at one (q, δu): over the patch DoFs p (3 per patch
+/// node, cache order) and the term's local layout q.
+struct ContactPatchTerm::Evaluation {
+  double energy = 0;
+  VecX gp;   // ∂Φ/∂δu
+  MatX Hpp;  // its PSD approximation
+  VecX gq;   // ∂Φ/∂q
+  MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
+  MatX Hqp;  // cross block (layout rows by patch DoFs)
+  MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q Hessian)
+  Vec3 force = Vec3::Zero();
+  int active = 0;
+  double depth = 0, area = 0;
+};
+
+namespace contact_patch_detail {
+
+struct PatchHistory {
+  Vec3 du = Vec3::Zero();       // unposed displacement at t (warm start)
+  Vec3 d_t = Vec3::Zero();      // world offset A δu at t
+  Vec3 d_prev = Vec3::Zero();   // at t − h
+  Vec3 du_next = Vec3::Zero();  // fixed by report() for t + h
+  Vec3 d_next = Vec3::Zero();
+};
+
+struct PatchCache : TermCache {
+  Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h
+  std::vector<int> faces;                      // candidate skin faces
+  std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
+  std::vector<int> face_first;                 // samples of faces[i]: [face_first[i], face_first[i+1])
+  std::vector<int> vertices;                   // distinct vertices of the candidate faces
+  std::unordered_map<int, int> vertex_slot;    // vertex → index into `vertices`
+  std::vector<int> nodes;                      // patch nodes
+  std::unordered_map<int, int> node_slot;      // node → index into `nodes`
+  std::vector<int> tets;                       // tets with a patch node
+  // Per patch tet (`tets` order): its nodes as indices into `tet_nodes`, their
+  // patch slots (−1: not a patch node), and the material's small-strain Hessian.
+  std::vector<int> tet_nodes;                  // distinct nodes of the patch tets
+  std::vector<std::array<int, 4>> tet_local, tet_slot;
+  std::vector<Mat9> tet_H2;
+  std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
+  std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node
+  std::vector<Vec3> sample_x_star;             // their predictions
+  VecX du;                                     // last minimizer (3 per patch node)
+  int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
+  // The configuration `du` minimizes Φ at (skipped when asked again), and the
+  // linearization of the last Hessian evaluation: δu(z) ≈ du_lin − Φ_pp⁻¹ Φ_pz (z − z_lin).
+  bool solved = false;
+  Configuration q_solved;
+  Isometry object_solved = Isometry::Identity();
+  bool linearized = false;
+  VecX z_lin, du_lin;
+  MatX Hpz;                     // Φ_pz (patch DoFs by z)
+  Eigen::LLT<MatX> Hpp_llt;
+  std::unordered_map<int, PatchHistory> history;
+};
+
+inline PatchCache& patch_cache(const StepContext& ctx, const std::string& name) {
+  require(ctx.cache != nullptr, name, ": no cache (call begin_step through begin_term_step or the integrator)");
+  return static_cast<PatchCache&>(*ctx.cache);
+}
+
+inline const DofLayout& local_layout(const StepContext& ctx) {
+  return ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
+}
+
+/// Adds the generalized force of a world force `f` on an offset d = Σ_j w_j R_j o
+/// (o unposed) to the bones' rotations: ∂d/∂ω_j = −[w_j R_j o]×, so bone j's
+/// ω gains (w_j R_j o) × f (translations do not move an offset).
+template <class Row>
+void add_offset_rotation_gradient(const Row& w, const std::vector<Isometry>& bones, const Vec3& o, const Vec3& f,
+                                  const DofLayout& L, VecX& gq) {
+  if (!L.bones_dynamic) return;
+  for (int j = 0; j < w.size(); ++j)
+    if (w[j] != 0.0) gq.segment<3>(L.bone_offset(j)) += (w[j] * (bones[j].linear() * o)).cross(f);
+}
+
+}  // namespace contact_patch_detail
+}  // namespace sflsh

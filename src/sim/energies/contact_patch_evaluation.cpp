@@ -1,0 +1,433 @@
+// One evaluation of the patch's Φ(q, δu) and its derivatives
+// (contact_patch.hpp's header comment): inertia, elasticity, contact.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include "sflsh/core/rotation.hpp"
+#include "sflsh/sim/compression_guard.hpp"
+#include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/linearized_stiffness.hpp"
+#include "sflsh/sim/point_hessian.hpp"
+#include "sim/energies/contact_patch_cache.hpp"
+
+namespace sflsh {
+
+using contact_patch_detail::add_offset_rotation_gradient;
+using contact_patch_detail::local_layout;
+using contact_patch_detail::patch_cache;
+using contact_patch_detail::PatchCache;
+
+double ContactPatchTerm::subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
+  const MaterialPoint& m = materials_[t];
+  Mat9 Hq = H2;
+  if (dilatation_cell_.size() > 0 && dilatation_cell_[t] >= 0) {
+    // The tet's own share of the mean-dilatation quadratic (linearized_stiffness.cpp):
+    // α H₂ + (1 − α) P H₂ P, P = I − v vᵀ/3 the deviatoric projector (v = vec I);
+    // the cell's mean stays in the subspace. P H₂ P = H₂ − u vᵀ − v uᵀ + (vᵀH₂v/9) v vᵀ, u = H₂v/3.
+    Vec9 v = Vec9::Zero();
+    v[0] = v[4] = v[8] = 1.0;
+    const Vec9 u = H2 * v / 3.0;
+    const double b = v.dot(u) / 3.0;
+    Hq.noalias() -= (1.0 - kPerTetVolumeShare) * (u * v.transpose() + v * u.transpose() - b * v * v.transpose());
+  }
+  const Mat3 D = F - Mat3::Identity();
+  const Vec9 h = Eigen::Map<const Vec9>(D.data());
+  const Vec9 Hqh = Hq * h;
+  double psi = 0.5 * h.dot(Hqh);
+  if (P) *P = Eigen::Map<const Mat3>(Hqh.data());
+  if (H) *H = Hq;
+  // The cubature's remainder Ψ − Ψ₂ (and the compression guard), weighted as the samples in the tet.
+  const double c = cubature_weight_[t] / tet_volume_[t];
+  if (c == 0.0) return psi;
+  Mat3 Pr;
+  Mat9 Hr;
+  const Vec9 H2h = H2 * h;
+  double r = strain_energy_density(F, m, P ? &Pr : nullptr, H ? &Hr : nullptr, true) - 0.5 * h.dot(H2h);
+  if (P) Pr -= Eigen::Map<const Mat3>(H2h.data());
+  if (H) Hr -= H2;
+  if (options_.subspace_mean_dilatation)
+    r += compression_guard(F, (1.0 - kPerTetVolumeShare) * m.kappa, kCompressionGuardOnset, P ? &Pr : nullptr,
+                           H ? &Hr : nullptr, true);
+  if (P) *P += c * Pr;
+  // The Hessian serves the cross block Φ_zp only (evaluate_patch): a sample
+  // standing for many tets' volume (c ≫ 1) holds its remainder with that
+  // weight, but δu couples to z through this tet's own volume.
+  if (H) *H += std::min(c, 1.0) * Hr;
+  return psi + c * r;
+}
+
+double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du,
+                                        const EvaluationMode& mode, Evaluation& out) const {
+  const bool q_derivatives = mode.q_derivatives, q_hessian = q_derivatives && mode.q_hessian;
+  const DofLayout& L = local_layout(ctx);
+  const int ob = object_offset(ctx);  // the object's 6 DoFs in the term's system, or −1
+  const int nq = std::max(L.end(), ob + 6), np = int(du.size());
+  out = Evaluation();
+  out.gp = VecX::Zero(np);
+  out.Hpp = MatX::Zero(np, np);
+  if (q_derivatives) out.gq = VecX::Zero(nq);
+  if (q_hessian) {
+    out.Hqq = MatX::Zero(nq, nq);
+    out.Hqp = MatX::Zero(nq, np);
+    out.K0pp = MatX::Zero(np, np);
+  }
+  const double inertia = add_patch_inertia(ctx, q, du, mode, out);
+  const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);
+  if (!std::isfinite(elasticity)) return out.energy = std::numeric_limits<double>::infinity();
+  return out.energy = inertia + elasticity + add_patch_contact(ctx, q, du, mode, out);
+}
+
+double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configuration& q, const VecX& du,
+                                           const EvaluationMode& mode, Evaluation& out) const {
+  const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
+  const bool q_hessian = q_derivatives && mode.q_hessian;
+  const PatchCache& c = patch_cache(ctx, name());
+  const Avatar& a = *avatar_;
+  const DofLayout& L = local_layout(ctx);
+  const double inv_h2 = 1.0 / (ctx.h * ctx.h);
+  double E = 0;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  MatRef Hqq(out.Hqq);  // c JᵀJ block by block (point_hessian.hpp)
+  // Inertia and gravity of the patch's offsets.
+  std::vector<Mat3> A(c.nodes.size());
+  for (size_t i = 0; i < c.nodes.size(); ++i) {
+    const int n = c.nodes[i];
+    const double m = node_mass_[n];
+    A[i] = skinning_rotation_blend(a.node_weights.row(n), q.bones);
+    const Vec3 d = A[i] * du.segment<3>(3 * i);
+    const Vec3 e = d - c.d_pred[i];
+    const Vec3 r = nodes_.world_point(n, q) - c.x_star[i];
+    E += 0.5 * m * inv_h2 * (r + e).squaredNorm() - m * ctx.gravity.dot(d);
+    if (!p_derivatives) continue;
+    const Vec3 fd = m * inv_h2 * (r + e) - m * ctx.gravity;  // ∂Φ/∂d
+    out.gp.segment<3>(3 * i) += A[i].transpose() * fd;
+    out.Hpp.block<3, 3>(3 * i, 3 * i) += m * inv_h2 * A[i].transpose() * A[i];
+    if (!q_derivatives) continue;
+    add_offset_rotation_gradient(a.node_weights.row(n), q.bones, du.segment<3>(3 * i), fd, L, out.gq);
+    nodes_.local_jacobian(n, q, L, J, cols);
+    const Vec3 ge = m * inv_h2 * (r + e);
+    if (!q_hessian) {
+      for (size_t k = 0; k < cols.size(); ++k) out.gq[cols[k]] += J.col(long(k)).dot(ge);
+      continue;
+    }
+    const MatX JA = J.transpose() * (m * inv_h2 * A[i]);
+    for (size_t k = 0; k < cols.size(); ++k) {
+      out.gq[cols[k]] += J.col(k).dot(ge);
+      out.Hqp.block<1, 3>(cols[k], 3 * i) += JA.row(k);
+    }
+    add_point_hessian(nodes_, n, q, L, m * inv_h2, Hqq);
+  }
+  // What the subspace's inertia term holds of the patch: its samples there
+  // (header comment, "What the patch subtracts").
+  if (mode.subspace_energy || q_derivatives)
+    for (size_t k = 0; k < c.samples_in_patch.size(); ++k) {
+      const int s = c.samples_in_patch[k];
+      const double m = inertia_mass_[s];
+      const Vec3 r = inertia_points_.world_point(s, q) - c.sample_x_star[k];
+      E -= 0.5 * m * inv_h2 * r.squaredNorm();
+      if (!q_derivatives) continue;
+      inertia_points_.local_jacobian(s, q, L, J, cols);
+      const Vec3 gr = m * inv_h2 * r;
+      for (size_t i = 0; i < cols.size(); ++i) out.gq[cols[i]] -= J.col(long(i)).dot(gr);
+      if (q_hessian) add_point_hessian(inertia_points_, s, q, L, -m * inv_h2, Hqq);
+    }
+  return E;
+}
+
+namespace {
+
+/// The 3x3 blocks K_kl = V Σ_{b,c} g_k[b] g_l[c] H_(b,c) of a tet's stiffness
+/// (g_k node k's shape gradient, H_(b,c) the 3x3 block of ∂²Ψ/∂vec(F)² that
+/// couples F's columns b and c) for a symmetric H: K_lk = K_klᵀ.
+using ElementBlocks = std::array<std::array<Mat3, 4>, 4>;
+ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, const Mat9& H) {
+  std::array<Eigen::Matrix<double, 3, 9>, 4> T;  // T_k = Σ_b g_k[b] H(3b.., :)
+  for (int k = 0; k < 4; ++k)
+    T[k] = G(k, 0) * H.middleRows<3>(0) + G(k, 1) * H.middleRows<3>(3) + G(k, 2) * H.middleRows<3>(6);
+  ElementBlocks K;
+  for (int k = 0; k < 4; ++k)
+    for (int l = k; l < 4; ++l) {
+      K[k][l] = V * (G(l, 0) * T[k].middleCols<3>(0) + G(l, 1) * T[k].middleCols<3>(3) +
+                     G(l, 2) * T[k].middleCols<3>(6));
+      if (l != k) K[l][k] = K[k][l].transpose();
+    }
+  return K;
+}
+
+}  // namespace
+
+// Elasticity: the exact change δu brings to each patch tet.
+// With mean dilatation the subspace holds only α of each tet's own bulk
+// stiffness (subspace_density), so Φ_zz gains the rest, (1 − α) κ_t V_t
+// (Wᵀ b_t)(Wᵀ b_t)ᵀ with b_t the tet's volume-change gradient (κ_t = vᵀH₂v/9,
+// the rank-one bulk part of the material's small-strain Hessian): a PSD
+// Gauss–Newton part of Φ_zz that the one Newton step needs (without it the
+// step overshoots where the patch is). Collected as columns over the
+// handles the patch's tets touch, then one rank update.
+double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Configuration& q, const VecX& du,
+                                              const EvaluationMode& mode, Evaluation& out) const {
+  const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
+  const bool q_hessian = q_derivatives && mode.q_hessian;
+  const bool subspace = mode.subspace_energy || q_derivatives;
+  const PatchCache& c = patch_cache(ctx, name());
+  const Avatar& a = *avatar_;
+  const int z0 = local_layout(ctx).z_offset();
+  auto simulated = [&](int n) { return a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated); };
+  // The subspace's displacement W_n z at each node of the patch's tets.
+  const size_t nt = c.tet_nodes.size(), np3 = size_t(du.size()) / 3;
+  std::vector<Vec3> us(nt, Vec3::Zero());
+  for (size_t i = 0; i < nt; ++i)
+    if (simulated(c.tet_nodes[i]))
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, c.tet_nodes[i]); it; ++it)
+        us[i] += it.value() * q.z.segment<3>(3 * it.col());
+  // Per tet node: ∂Φ/∂u_n and the cross blocks K0 against the patch slots,
+  // taken through W once per node after the loop.
+  std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());
+  std::vector<Mat3> node_cross(q_hessian ? nt * np3 : 0, Mat3::Zero());
+  std::vector<char> node_cross_used(node_cross.size(), 0);
+  const bool bulk_hessian = q_hessian && dilatation_cell_.size() > 0;
+  std::vector<int> bulk_index(bulk_hessian ? size_t(a.num_handles()) : 0, -1);  // handle → compressed index
+  std::vector<int> bulk_handles;
+  std::vector<std::pair<int, Vec3>> bulk_entries;
+  std::vector<int> bulk_first{0};
+  double E = 0;
+  for (size_t ti = 0; ti < c.tets.size(); ++ti) {
+    const int t = c.tets[ti];
+    const std::array<int, 4>& local = c.tet_local[ti];
+    const std::array<int, 4>& slot = c.tet_slot[ti];
+    Mat3 F0 = Mat3::Identity(), F1 = Mat3::Identity();
+    for (int k = 0; k < 4; ++k) {
+      const Vec3& u0 = us[size_t(local[k])];
+      const Vec3 u1 = slot[k] >= 0 ? Vec3(u0 + du.segment<3>(3 * slot[k])) : u0;
+      F0 += u0 * grads_[t].row(k);
+      F1 += u1 * grads_[t].row(k);
+    }
+    Mat3 P0, P1;
+    Mat9 H1, H0;
+    const double psi1 = strain_energy_density(F1, materials_[t], p_derivatives ? &P1 : nullptr,
+                                              p_derivatives ? &H1 : nullptr, mode.project);
+    if (!std::isfinite(psi1)) return std::numeric_limits<double>::infinity();
+    const double V = tet_volume_[t];
+    E += V * psi1;
+    // What the subspace's elastic term holds of the tet: constant while δu varies (left out then).
+    const Mat9& H2 = c.tet_H2[ti];
+    if (subspace) E -= V * subspace_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
+    if (!p_derivatives) continue;
+    const ElementBlocks K = element_blocks(grads_[t], V, H1);
+    // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken at the subspace's own
+    // state, Wᵀ K(Wz): the Schur complement Wᵀ K0 (K1 + M + C)⁻¹ K0 W then
+    // stays below the subspace's stiffness of these tets, Wᵀ K0 W, which its
+    // elastic term carries, so the step's Hessian stays positive semi-definite
+    // where the dent stiffens the tissue (K1 ≫ K0 under the Fung saturation).
+    // Only the Hessian is approximated: the gradient and the energy are exact.
+    ElementBlocks K0;
+    if (q_hessian) K0 = element_blocks(grads_[t], V, H0);
+    if (bulk_hessian && dilatation_cell_[t] >= 0) {
+      Vec9 v = Vec9::Zero();
+      v[0] = v[4] = v[8] = 1.0;
+      const double kappa = v.dot(H2 * v) / 9.0;
+      const double scale = std::sqrt((1.0 - kPerTetVolumeShare) * kappa * V);
+      for (int k = 0; k < 4; ++k) {
+        const int n = a.tet.elements(t, k);
+        if (!simulated(n)) continue;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
+          int& h = bulk_index[size_t(it.col())];
+          if (h < 0) h = int(bulk_handles.size()), bulk_handles.push_back(int(it.col()));
+          bulk_entries.emplace_back(h, scale * it.value() * grads_[t].row(k).transpose());
+        }
+      }
+      bulk_first.push_back(int(bulk_entries.size()));
+    }
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 gk = grads_[t].row(k).transpose();
+      if (slot[k] >= 0) {
+        out.gp.segment<3>(3 * slot[k]) += V * (P1 * gk);
+        for (int l = 0; l < 4; ++l)
+          if (slot[l] >= 0) {
+            out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
+            if (q_hessian) out.K0pp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K0[k][l];
+          }
+      }
+      if (!q_derivatives) continue;
+      node_grad[size_t(local[k])] += V * ((P1 - P0) * gk);
+      if (!q_hessian) continue;
+      for (int l = 0; l < 4; ++l)
+        if (slot[l] >= 0) {
+          const size_t e = size_t(local[k]) * np3 + size_t(slot[l]);
+          node_cross[e] += K0[k][l];
+          node_cross_used[e] = 1;
+        }
+    }
+  }
+  if (q_derivatives)
+    for (size_t i = 0; i < nt; ++i) {
+      const int n = c.tet_nodes[i];
+      if (!simulated(n)) continue;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
+        const int row = z0 + 3 * int(it.col());
+        out.gq.segment<3>(row) += it.value() * node_grad[i];
+        if (!q_hessian) continue;
+        for (size_t p = 0; p < np3; ++p)
+          if (node_cross_used[i * np3 + p]) out.Hqp.block<3, 3>(row, 3 * long(p)) += it.value() * node_cross[i * np3 + p];
+      }
+    }
+  if (bulk_hessian && !bulk_handles.empty()) {
+    MatX C = MatX::Zero(3 * long(bulk_handles.size()), long(bulk_first.size()) - 1);
+    for (size_t e = 0; e + 1 < bulk_first.size(); ++e)
+      for (int i = bulk_first[e]; i < bulk_first[e + 1]; ++i)
+        C.block<3, 1>(3 * bulk_entries[size_t(i)].first, long(e)) += bulk_entries[size_t(i)].second;
+    MatX G = MatX::Zero(C.rows(), C.rows());
+    G.selfadjointView<Eigen::Lower>().rankUpdate(C);
+    G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
+    for (size_t ia = 0; ia < bulk_handles.size(); ++ia)
+      for (size_t ib = 0; ib < bulk_handles.size(); ++ib)
+        out.Hqq.block<3, 3>(z0 + 3 * bulk_handles[ia], z0 + 3 * bulk_handles[ib]) +=
+            G.block<3, 3>(3 * long(ia), 3 * long(ib));
+  }
+  return E;
+}
+
+double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configuration& q, const VecX& du,
+                                           const EvaluationMode& mode, Evaluation& out) const {
+  const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
+  const bool q_hessian = q_derivatives && mode.q_hessian;
+  const PatchCache& c = patch_cache(ctx, name());
+  const Avatar& a = *avatar_;
+  const DofLayout& L = local_layout(ctx);
+  const int ob = object_offset(ctx);  // the object's 6 DoFs in the term's system, or −1
+  double E = 0;
+  // Contact over the candidate faces' samples.
+  const Isometry T = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * shape_in_frame_) : c.field_pose;
+  const Isometry T_inv = T.inverse();
+  // A dynamic object: g_o = Σ_s −J_oᵀ g_s, H_oo = Σ_s J_oᵀ H_s J_o, and per vertex
+  // N_v = Σ_s −λ_v J_oᵀ H_s, J_o = [−[x_s]×, I] (the object's point at x_s moves by ω × x + v).
+  using Mat63 = Eigen::Matrix<double, 6, 3>;
+  std::vector<Mat63> Nv(ob >= 0 && q_hessian ? c.vertices.size() : 0, Mat63::Zero());
+  const double kappa = options_.pressure_stiffness;
+  const size_t nv = c.vertices.size();
+  std::vector<Vec3> xv(nv);
+  std::vector<Mat3> Av(nv);
+  std::vector<Vec3> offset(nv);  // Σ_c b_c δu_c of each vertex (unposed)
+  // Patch coupling of each vertex: (patch slot, barycentric weight) over its tet's nodes.
+  std::vector<std::array<std::pair<int, double>, 4>> couple(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    const int v = c.vertices[i];
+    Av[i] = skinning_rotation_blend(a.surface_weights.row(v), q.bones);
+    Vec3 off = Vec3::Zero();
+    const int t = a.surface_tet[v];
+    for (int k = 0; k < 4; ++k) {
+      const auto s = c.node_slot.find(a.tet.elements(t, k));
+      couple[i][k] = {s == c.node_slot.end() ? -1 : s->second, a.surface_bary(v, k)};
+      if (couple[i][k].first >= 0) off += couple[i][k].second * du.segment<3>(3 * couple[i][k].first);
+    }
+    offset[i] = off;
+    xv[i] = vertices_.world_point(v, q) + Av[i] * off;
+  }
+  // Per vertex (slot): g_v = Σ_s λ_v g_s, and per vertex pair M_vw = Σ_s λ_v λ_w H_s
+  // over the touching samples of their faces; the Jacobians are applied once per vertex pair.
+  std::vector<Vec3> gv(p_derivatives ? nv : 0, Vec3::Zero());
+  std::unordered_map<long, Mat3> Mvw;
+  for (size_t fi = 0; fi < c.faces.size(); ++fi) {
+    const int fc = c.faces[fi];
+    std::array<int, 3> vs;
+    for (int i = 0; i < 3; ++i) vs[i] = c.vertex_slot.at(a.surface_faces(fc, i));
+    std::array<Vec3, 3> g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    std::array<std::array<Mat3, 3>, 3> M;
+    for (auto& row : M) row.fill(Mat3::Zero());
+    bool touching = false;
+    for (int s = c.face_first[fi]; s < c.face_first[fi + 1]; ++s) {
+      const SkinFaceSample& smp = c.samples[s];
+      const Vec3 x = smp.lambda[0] * xv[vs[0]] + smp.lambda[1] * xv[vs[1]] + smp.lambda[2] * xv[vs[2]];
+      const geometry::SdfSample sd = field_->evaluate(T_inv * x);
+      if (!(sd.distance < 0)) continue;
+      touching = p_derivatives;
+      const double k = kappa * smp.area, d = sd.distance;
+      const Vec3 nrm = T.linear() * sd.gradient;
+      E += 0.5 * k * d * d;
+      out.force -= k * d * nrm;
+      ++out.active;
+      out.depth = std::max(out.depth, -d);
+      out.area += smp.area;
+      if (!p_derivatives) continue;
+      const Mat3 H = k * nrm * nrm.transpose();
+      for (int i = 0; i < 3; ++i) {
+        g[i] += smp.lambda[i] * k * d * nrm;
+        for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
+      }
+      if (ob < 0 || !q_derivatives) continue;
+      Mat63 JoT;  // J_oᵀ
+      JoT << hat(x), Mat3::Identity();
+      const Vec3 gs = k * d * nrm;
+      out.gq.segment<6>(ob) -= JoT * gs;
+      if (!q_hessian) continue;
+      out.Hqq.block<6, 6>(ob, ob) += JoT * H * JoT.transpose();
+      for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
+    }
+    if (!touching) continue;
+    for (int i = 0; i < 3; ++i) {
+      gv[vs[i]] += g[i];
+      for (int j = 0; j < 3; ++j)
+        Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
+    }
+  }
+  if (!p_derivatives || Mvw.empty()) return E;
+  // Patch DoFs: ∂x_v/∂δu_c = b_vc A_v.
+  for (size_t v = 0; v < nv; ++v)
+    for (const auto& [pi, bi] : couple[v])
+      if (pi >= 0 && bi != 0.0) out.gp.segment<3>(3 * pi) += (bi * Av[v]).transpose() * gv[v];
+  for (const auto& [key, M] : Mvw) {
+    const int v = int(key / long(nv)), w = int(key % long(nv));
+    for (const auto& [pi, bi] : couple[v]) {
+      if (pi < 0 || bi == 0.0) continue;
+      const Mat3 BM = (bi * Av[v]).transpose() * M;
+      for (const auto& [pj, bj] : couple[w])
+        if (pj >= 0 && bj != 0.0) out.Hpp.block<3, 3>(3 * pi, 3 * pj) += BM * (bj * Av[w]);
+    }
+  }
+  if (!q_derivatives) return E;
+  // Subspace DoFs: ∂x_v/∂q = J_v (and the offsets' rotation with the bones).
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> Jv(nv);
+  std::vector<std::vector<int>> cv(nv);
+  std::vector<char> touched(nv, 0);
+  for (const auto& [key, M] : Mvw) touched[size_t(key / long(nv))] = 1;
+  for (size_t v = 0; v < nv; ++v) {
+    if (!touched[v]) continue;
+    vertices_.local_jacobian(c.vertices[v], q, L, Jv[v], cv[v]);
+    add_offset_rotation_gradient(a.surface_weights.row(c.vertices[v]), q.bones, offset[v], gv[v], L, out.gq);
+    const Eigen::VectorXd gq = Jv[v].transpose() * gv[v];
+    for (size_t k = 0; k < cv[v].size(); ++k) out.gq[cv[v][k]] += gq[k];
+  }
+  if (!q_hessian) return E;
+  for (size_t v = 0; v < Nv.size(); ++v) {
+    if (!touched[v]) continue;
+    // Object rows: N_v J_v against the body, N_v b A_v against the patch.
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> B = Nv[v] * Jv[v];
+    for (size_t k = 0; k < cv[v].size(); ++k) {
+      out.Hqq.block<6, 1>(ob, cv[v][k]) += B.col(long(k));
+      out.Hqq.block<1, 6>(cv[v][k], ob) += B.col(long(k)).transpose();
+    }
+    for (const auto& [pj, bj] : couple[v])
+      if (pj >= 0 && bj != 0.0) out.Hqp.block<6, 3>(ob, 3 * pj) += Nv[v] * (bj * Av[v]);
+  }
+  for (const auto& [key, M] : Mvw) {
+    const int v = int(key / long(nv)), w = int(key % long(nv));
+    const Eigen::Matrix<double, Eigen::Dynamic, 3> JM = Jv[v].transpose() * M;
+    const MatX B = JM * Jv[w];
+    for (size_t k = 0; k < cv[v].size(); ++k)
+      for (size_t l = 0; l < cv[w].size(); ++l) out.Hqq(cv[v][k], cv[w][l]) += B(long(k), long(l));
+    for (const auto& [pj, bj] : couple[w]) {
+      if (pj < 0 || bj == 0.0) continue;
+      const Eigen::Matrix<double, Eigen::Dynamic, 3> C = JM * (bj * Av[w]);
+      for (size_t k = 0; k < cv[v].size(); ++k) out.Hqp.block<1, 3>(cv[v][k], 3 * pj) += C.row(long(k));
+    }
+  }
+  return E;
+}
+
+
+}  // namespace sflsh
