@@ -122,6 +122,54 @@ std::unique_ptr<TermCache> ContactPatchTerm::make_cache() const { return std::ma
 
 std::vector<int> ContactPatchTerm::patch_nodes(const StepContext& ctx) const { return patch_cache(ctx, name()).nodes; }
 
+/// Patch nodes: Simulated nodes within patch_radius (unposed) of a seed (a
+/// skin vertex near the object; seed_phi its φ), nearest the deepest seeds
+/// first when there are too many, and every node still displaced.
+void ContactPatchTerm::select_patch_nodes(TermCache& cache, const std::vector<int>& seeds,
+                                          const std::vector<double>& seed_phi) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  c.nodes.clear();
+  c.node_slot.clear();
+  auto add_node = [&](int n) {
+    if (c.node_slot.emplace(n, int(c.nodes.size())).second) c.nodes.push_back(n);
+  };
+  if (options_.patch) {
+    const double r2 = options_.patch_radius * options_.patch_radius;
+    if (!seeds.empty()) {
+      // Bounding box of the seeds first: most nodes are far.
+      Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+      for (int v : seeds) {
+        lo = lo.cwiseMin(Vec3(a.surface_rest.row(v).transpose()));
+        hi = hi.cwiseMax(Vec3(a.surface_rest.row(v).transpose()));
+      }
+      lo.array() -= options_.patch_radius;
+      hi.array() += options_.patch_radius;
+      // Each node within the radius, ranked by its distance to a seed
+      // plus that vertex's φ: the deepest contact's nodes first when the patch
+      // is over max_patch_nodes (a broad press).
+      std::vector<std::pair<double, int>> ranked;
+      for (int n = 0; n < a.tet.num_nodes(); ++n) {
+        if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+        const Vec3 y = a.tet.nodes.row(n).transpose();
+        if ((y.array() < lo.array()).any() || (y.array() > hi.array()).any()) continue;
+        double rank = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < seeds.size(); ++i) {
+          const double d2 = (y - a.surface_rest.row(seeds[i]).transpose()).squaredNorm();
+          if (d2 <= r2) rank = std::min(rank, std::sqrt(d2) + seed_phi[i]);
+        }
+        if (std::isfinite(rank)) ranked.emplace_back(rank, n);
+      }
+      if (int(ranked.size()) > options_.max_patch_nodes) {
+        std::nth_element(ranked.begin(), ranked.begin() + options_.max_patch_nodes, ranked.end());
+        ranked.resize(size_t(options_.max_patch_nodes));
+      }
+      for (const auto& [rank, n] : ranked) add_node(n);
+    }
+    for (const auto& [n, h] : c.history) add_node(n);
+  }
+}
+
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
@@ -218,47 +266,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
       if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
     }
   }
-  // Patch nodes: Simulated nodes within the radius of a near vertex (unposed),
-  // and every node still displaced.
-  c.nodes.clear();
-  c.node_slot.clear();
-  auto add_node = [&](int n) {
-    if (c.node_slot.emplace(n, int(c.nodes.size())).second) c.nodes.push_back(n);
-  };
-  if (options_.patch) {
-    const double r2 = options_.patch_radius * options_.patch_radius;
-    if (!near.empty()) {
-      // Bounding box of the near vertices first: most nodes are far.
-      Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-      for (int v : near) {
-        lo = lo.cwiseMin(Vec3(a.surface_rest.row(v).transpose()));
-        hi = hi.cwiseMax(Vec3(a.surface_rest.row(v).transpose()));
-      }
-      lo.array() -= options_.patch_radius;
-      hi.array() += options_.patch_radius;
-      // Each node within the radius, ranked by its distance to a near vertex
-      // plus that vertex's φ: the deepest contact's nodes first when the patch
-      // is over max_patch_nodes (a broad press).
-      std::vector<std::pair<double, int>> ranked;
-      for (int n = 0; n < a.tet.num_nodes(); ++n) {
-        if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
-        const Vec3 y = a.tet.nodes.row(n).transpose();
-        if ((y.array() < lo.array()).any() || (y.array() > hi.array()).any()) continue;
-        double rank = std::numeric_limits<double>::infinity();
-        for (size_t i = 0; i < near.size(); ++i) {
-          const double d2 = (y - a.surface_rest.row(near[i]).transpose()).squaredNorm();
-          if (d2 <= r2) rank = std::min(rank, std::sqrt(d2) + near_phi[i]);
-        }
-        if (std::isfinite(rank)) ranked.emplace_back(rank, n);
-      }
-      if (int(ranked.size()) > options_.max_patch_nodes) {
-        std::nth_element(ranked.begin(), ranked.begin() + options_.max_patch_nodes, ranked.end());
-        ranked.resize(size_t(options_.max_patch_nodes));
-      }
-      for (const auto& [rank, n] : ranked) add_node(n);
-    }
-    for (const auto& [n, h] : c.history) add_node(n);
-  }
+  select_patch_nodes(c, near, near_phi);
   std::sort(c.nodes.begin(), c.nodes.end());
   c.node_slot.clear();
   for (int i = 0; i < int(c.nodes.size()); ++i) c.node_slot[c.nodes[i]] = i;

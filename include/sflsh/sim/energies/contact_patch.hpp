@@ -162,6 +162,8 @@ class ContactPatchTerm : public EnergyTerm {
   /// (PSD-projected) is the stiffness the cross block Φ_zp takes for the tet
   /// (the remainder's weight capped at the tet's own volume).
   double subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
+  /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
+  void select_patch_nodes(TermCache& cache, const std::vector<int>& seeds, const std::vector<double>& seed_phi) const;
   /// The dynamic object's 6 DoFs in the term's local system, or −1.
   int object_offset(const StepContext& ctx) const;
 
