@@ -42,6 +42,7 @@ export class ResultTools {
       events.appendChild(li);
       return { li, time: e.time };
     });
+    if (!this.items.length) events.appendChild(Object.assign(document.createElement('li'), { textContent: 'none' }));
   }
 
   // Poses the markers and arrows from a frame's info.tools (3-D view, every frame).
