@@ -30,9 +30,7 @@ void run_view(const ViewArgs& a) {
           ": expected a value in [", viewer::kMinPlaybackSpeed, ", ", viewer::kMaxPlaybackSpeed, "]");
   const SimulationResult result = read_simulation_result(a.result);
   require(result.num_frames > 0 && !result.frame_positions.empty(), a.result, ": the result has no frames to play");
-  viewer::ViewerScene scene = viewer::viewer_scene(result, {}, 0.05, 0.001);
-  scene.mode = "playback";
-  scene.title = std::filesystem::path(a.result).filename().string();
+  viewer::ViewerScene scene = viewer::playback_scene(result, std::filesystem::path(a.result).filename().string());
   viewer::ViewerServerOptions o;
   o.bind = a.bind;
   o.port = a.port;

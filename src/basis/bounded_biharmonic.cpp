@@ -11,7 +11,7 @@
 
 #include <thread>
 
-#include "basis/cholmod_llt.hpp"
+#include "basis/bbw_internal.hpp"
 #include "basis/edge_path_distance.hpp"
 #include "sflsh/basis/depth_fraction.hpp"
 #include "sflsh/asset/avatar.hpp"
@@ -23,257 +23,7 @@
 namespace sflsh::basis {
 namespace {
 
-using SpMat = Eigen::SparseMatrix<double>;
-
-/// Node states of the active-set method: free (inactive), at a bound, or
-/// outside the column's support (held at 0, not a bound: never released and
-/// not part of the KKT test).
-enum : char { kFree = 0, kLower = 1, kUpper = 2, kOutside = 3 };
-
-/// Rows/cols `keep` (ascending) of the symmetric column-major A; `map[i]` is
-/// the new index of old index i or −1.
-SpMat principal_submatrix(const SpMat& A, const std::vector<int>& keep, const std::vector<int>& map) {
-  std::vector<Eigen::Triplet<double>> trip;
-  for (size_t c = 0; c < keep.size(); ++c)
-    for (SpMat::InnerIterator it(A, keep[c]); it; ++it) {
-      const int r = map[it.row()];
-      if (r >= int(c)) trip.emplace_back(r, int(c), it.value());  // lower triangle is all CHOLMOD reads
-    }
-  SpMat S(int(keep.size()), int(keep.size()));
-  S.setFromTriplets(trip.begin(), trip.end());
-  S.makeCompressed();
-  return S;
-}
-
-/// Dimensionless KKT residual of x for min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1 with
-/// gradient g = Ax + q (see BbwReport::kkt_residual).
-/// Nodes marked in `outside` (when non-null) are held values, not bounds: skipped.
-double kkt_residual(const VecX& x, const VecX& g, double qnorm, const std::vector<char>* outside = nullptr) {
-  double r = 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    if (outside && (*outside)[size_t(i)]) continue;
-    const double viol = std::max({0.0, -x(i), x(i) - 1.0});
-    double pg;
-    if (x(i) <= 0.0) pg = std::max(0.0, -g(i));
-    else if (x(i) >= 1.0) pg = std::max(0.0, g(i));
-    else pg = std::abs(g(i));
-    r = std::max({r, viol, pg / qnorm});
-  }
-  return r;
-}
-
-struct ColumnResult {
-  VecX x;
-  std::vector<double> history;
-  int iterations = 0;
-  int max_inactive = 0;
-  int factorizations = 0;
-};
-
-/// Solves the inactive-set systems Q_II x_I = −q_I − Q_IA x_A of one column's
-/// active-set iterations. A fresh factorization per iteration dominated the
-/// cost, while most iterations move only a few nodes at the support boundary;
-/// so this keeps the CHOLMOD factor F of Q over a base set I0 and treats the
-/// difference to the current set I as a bordered system (Schur complement,
-/// i.e. a capacitance-matrix / Sherman–Morrison–Woodbury update; Hager 1989,
-/// "Updating the inverse of a matrix"): nodes of I \ I0 are extra rows and
-/// columns of Q, nodes of I0 \ I are held at their bound by Lagrange
-/// multipliers. The columns F⁻¹B of the border are cached per node, so a
-/// node that toggles back and forth costs one solve. When the cache would
-/// exceed `max_border` columns, I becomes the new base and is refactored.
-class InactiveSetSolver {
- public:
-  InactiveSetSolver(const SpMat& A, int max_border) : A_(A), max_border_(max_border) {
-    base_index_.assign(size_t(A.rows()), -1);
-    cache_col_.assign(size_t(A.rows()), -1);
-  }
-  int factorizations() const { return factorizations_; }
-
-  /// Overwrites x on the free nodes of `state` (others hold their bound value).
-  void solve(const std::vector<char>& state, const VecX& q, VecX& x) {
-    const int n = int(A_.rows());
-    std::vector<int> added, held;  // I \ I0, I0 \ I
-    int num_free = 0;
-    for (int i = 0; i < n; ++i) {
-      const bool is_free = state[i] == kFree;
-      num_free += is_free;
-      if (is_free && base_index_[i] < 0) added.push_back(i);
-      if (!is_free && base_index_[i] >= 0) held.push_back(i);
-    }
-    int uncached = 0;
-    for (int j : added) uncached += cache_col_[j] < 0;
-    for (int j : held) uncached += cache_col_[j] < 0;
-    if (!factored_ || cache_cols_ + uncached > max_border_) {
-      refactor(state, num_free);
-      added.clear(), held.clear();
-    }
-    const bool bordered = !added.empty() || !held.empty();
-    // Right-hand side with every node of I0 ∪ added unknown: r = −q − Q x_out.
-    VecX xo = x;
-    for (int i : base_) xo(i) = 0.0;
-    for (int i : added) xo(i) = 0.0;
-    const VecX r = -(q + A_ * xo);
-    MatX r0(base_.size(), 1);
-    for (size_t c = 0; c < base_.size(); ++c) r0(Eigen::Index(c), 0) = r(base_[c]);
-    const MatX y0 = llt_.solve(r0);
-    if (!bordered) {
-      for (size_t c = 0; c < base_.size(); ++c) x(base_[c]) = y0(Eigen::Index(c), 0);
-      return;
-    }
-    // Cache F⁻¹B for new border nodes: B e_j = Q(I0, j) for an added node,
-    // the unit vector of j for a held node.
-    std::vector<int> fresh;
-    for (int j : added)
-      if (cache_col_[j] < 0) fresh.push_back(j);
-    for (int j : held)
-      if (cache_col_[j] < 0) fresh.push_back(j);
-    if (!fresh.empty()) {
-      MatX B = MatX::Zero(Eigen::Index(base_.size()), Eigen::Index(fresh.size()));
-      for (size_t k = 0; k < fresh.size(); ++k) {
-        const int j = fresh[k];
-        if (base_index_[j] >= 0) {
-          B(base_index_[j], Eigen::Index(k)) = 1.0;
-        } else {
-          for (SpMat::InnerIterator it(A_, j); it; ++it)
-            if (base_index_[it.row()] >= 0) B(base_index_[it.row()], Eigen::Index(k)) = it.value();
-        }
-      }
-      const MatX Zn = llt_.solve(B);
-      if (Z_.cols() < cache_cols_ + Zn.cols())
-        Z_.conservativeResize(Z_.rows(), std::max<Eigen::Index>(cache_cols_ + Zn.cols(), 2 * Z_.cols()));
-      Z_.middleCols(cache_cols_, Zn.cols()) = Zn;
-      for (size_t k = 0; k < fresh.size(); ++k) cache_col_[fresh[k]] = cache_cols_ + int(k);
-      cache_cols_ += int(Zn.cols());
-    }
-    // Border order: added nodes, then held nodes. S = C − Bᵀ F⁻¹ B.
-    std::vector<int> border = added;
-    border.insert(border.end(), held.begin(), held.end());
-    const int m = int(border.size());
-    const int na = int(added.size());
-    std::vector<int> zc(m);
-    for (int k = 0; k < m; ++k) zc[k] = cache_col_[border[k]];
-    MatX S(m, m);
-    VecX rhs(m);
-    for (int a = 0; a < m; ++a) {
-      const int j = border[a];
-      // Row a of Bᵀ applied to [F⁻¹B | y0].
-      if (a >= na) {
-        const int bi = base_index_[j];
-        for (int b = 0; b < m; ++b) S(a, b) = -Z_(bi, zc[b]);
-        rhs(a) = (state[j] == kUpper ? 1.0 : 0.0) - y0(bi, 0);
-      } else {
-        S.row(a).setZero();
-        rhs(a) = r(j);
-        for (SpMat::InnerIterator it(A_, j); it; ++it) {
-          const int bi = base_index_[it.row()];
-          if (bi < 0) continue;
-          for (int b = 0; b < m; ++b) S(a, b) -= it.value() * Z_(bi, zc[b]);
-          rhs(a) -= it.value() * y0(bi, 0);
-        }
-      }
-    }
-    for (int a = 0; a < na; ++a)  // C: Q between added nodes
-      for (int b = 0; b < na; ++b) S(a, b) += A_.coeff(added[a], added[b]);
-    const VecX s = S.partialPivLu().solve(rhs);
-    VecX y = y0.col(0);
-    for (int b = 0; b < m; ++b) y -= s(b) * Z_.col(zc[b]);
-    for (size_t c = 0; c < base_.size(); ++c) x(base_[c]) = y(Eigen::Index(c));
-    for (int a = 0; a < na; ++a) x(added[a]) = s(a);
-    for (int j : held) x(j) = state[j] == kUpper ? 1.0 : 0.0;
-  }
-
- private:
-  void refactor(const std::vector<char>& state, int num_free) {
-    for (int i : base_) base_index_[i] = -1;
-    base_.clear();
-    base_.reserve(size_t(num_free));
-    for (int i = 0; i < int(A_.rows()); ++i)
-      if (state[i] == kFree) base_index_[i] = int(base_.size()), base_.push_back(i);
-    std::fill(cache_col_.begin(), cache_col_.end(), -1);
-    cache_cols_ = 0;
-    Z_.resize(Eigen::Index(base_.size()), std::min(max_border_, 64));
-    llt_.factor(principal_submatrix(A_, base_, base_index_), "bounded biharmonic weights: inactive-set system");
-    factored_ = true;
-    ++factorizations_;
-  }
-
-  const SpMat& A_;
-  const int max_border_;
-  detail::CholmodLLT llt_;
-  bool factored_ = false;
-  int factorizations_ = 0;
-  std::vector<int> base_, base_index_;  // I0 and its inverse (−1 outside)
-  std::vector<int> cache_col_;          // column of Z_ caching F⁻¹B e_j, or −1
-  int cache_cols_ = 0;
-  MatX Z_;
-};
-
-/// One bound-constrained QP  min ½xᵀAx + qᵀx, 0 ≤ x ≤ 1, by the primal–dual
-/// active-set method. `dist` (#free): distance (m) of each node to the fixed
-/// nodes with nonzero value; nodes farther than `radius` start at the lower
-/// bound (see BbwOptions::initial_radius_factor). Nodes marked in `outside`
-/// (#free, when non-null) lie outside the column's support: held at 0.
-ColumnResult solve_column(const SpMat& A, const VecX& q, const VecX& dist, double radius, const BbwOptions& opt,
-                          int column, const std::vector<char>* outside = nullptr) {
-  const int n = int(A.rows());
-  const double qnorm = std::max(q.lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
-  const double mtol = opt.multiplier_tolerance * qnorm;
-  ColumnResult res;
-  res.x = VecX::Zero(n);
-  std::vector<char> state(n);
-  for (int i = 0; i < n; ++i) state[i] = outside && (*outside)[i] ? kOutside : dist(i) <= radius ? kFree : kLower;
-  std::vector<int> released(n, 0);  // releases in the conservative phase, see below
-  std::vector<char> frozen(n, 0);
-
-  InactiveSetSolver solver(A, opt.max_border_columns);
-  VecX& x = res.x;
-  for (int it = 1; it <= opt.max_iterations; ++it) {
-    int num_free = 0;
-    for (int i = 0; i < n; ++i) {
-      if (state[i] != kFree) x(i) = state[i] == kUpper ? 1.0 : 0.0;
-      num_free += state[i] == kFree;
-    }
-    if (num_free > 0) solver.solve(state, q, x);
-    res.max_inactive = std::max(res.max_inactive, num_free);
-    const VecX g = A * x + q;  // multipliers on the active set
-    res.history.push_back(kkt_residual(x, g, qnorm, outside));
-    res.iterations = it;
-    res.factorizations = solver.factorizations();
-
-    // Active-set update. Plain PDAS first; after opt.pdas_iterations add-only,
-    // or release-only when nothing is violated. A node bound again after
-    // opt.max_releases such releases stays bound ("frozen"): every node is
-    // then released finitely often, so the iteration ends (add/release alone
-    // can cycle on long, thin supports, seen with free bones), and the KKT
-    // residual reports what freezing cost.
-    const bool conservative = it > opt.pdas_iterations;
-    bool primal_violation = false;
-    for (int i = 0; i < n; ++i)
-      if (state[i] == kFree && (x(i) < 0.0 || x(i) > 1.0)) primal_violation = true;
-    bool changed = false;
-    for (int i = 0; i < n; ++i) {
-      if (state[i] == kFree) {
-        if (x(i) < 0.0) state[i] = kLower, changed = true;
-        else if (x(i) > 1.0) state[i] = kUpper, changed = true;
-        if (state[i] != kFree && released[i] >= opt.max_releases) frozen[i] = 1;
-      } else if (state[i] != kOutside && !(conservative && (primal_violation || frozen[i]))) {
-        if ((state[i] == kLower && g(i) < -mtol) || (state[i] == kUpper && g(i) > mtol)) {
-          state[i] = kFree;
-          if (conservative) ++released[i];
-          changed = true;
-        }
-      }
-    }
-    // Settled, or converged to within kkt_tolerance while nodes at the C¹
-    // support boundary still toggle at round-off level (seen with free bones).
-    if (!changed || res.history.back() <= opt.kkt_tolerance) {
-      x = x.cwiseMax(0.0).cwiseMin(1.0);  // round-off on the inactive set
-      return res;
-    }
-  }
-  fail("bounded biharmonic weights: active-set iteration for column ", column, " did not settle in ",
-       opt.max_iterations, " iterations (KKT residual ", res.history.back(), ")");
-}
+using namespace bbw_internal;
 
 /// Requires every connected component of the mesh to contain a fixed node.
 void check_components_anchored(const TetMesh& mesh, const std::vector<char>& is_fixed) {
@@ -298,7 +48,6 @@ void check_components_anchored(const TetMesh& mesh, const std::vector<char>& is_
     require(used[i] || is_fixed[i], "bounded biharmonic weights: node ", i,
             " belongs to no tet; remove unreferenced nodes or fix them");
 }
-
 
 MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
                   const BbwOptions& options, BbwReport* report);
@@ -333,6 +82,86 @@ MatX bounded_biharmonic_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& 
 }
 
 namespace {
+
+/// Distance (m) of each free node to the fixed nodes with a nonzero value in `values`.
+VecX distances_to_sources(const TetMesh& mesh, const VecXi& fixed, const VecX& values, const std::vector<int>& free_nodes) {
+  const int nf = int(free_nodes.size());
+  VecX dist = VecX::Constant(nf, std::numeric_limits<double>::infinity());
+  for (int b = 0; b < fixed.size(); ++b) {
+    if (values(b) == 0.0) continue;
+    const Vec3 p = mesh.nodes.row(fixed(b)).transpose();
+    for (int f = 0; f < nf; ++f) dist(f) = std::min(dist(f), (mesh.nodes.row(free_nodes[f]).transpose() - p).norm());
+  }
+  return dist;
+}
+
+/// Calls run(c) for every column c < C: one worker per core (or `threads`) pulls
+/// columns from a shared counter (TBB is not linked into basis/; the columns are
+/// independent and similar in cost). Rethrows the first error.
+template <class Run>
+void for_each_column_in_parallel(int C, int threads, Run& run) {
+  std::atomic<int> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&] {
+    for (int c; (c = next++) < C;) {
+      try {
+        run(c);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = C;
+      }
+    }
+  };
+  const int cores = std::max(1, int(std::thread::hardware_concurrency()));
+  const int workers = std::max(1, std::min<int>(C, threads > 0 ? threads : cores));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < workers; ++t) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+/// The report of the column solves: iterations, KKT residuals, supports, times.
+BbwReport solve_report(const std::vector<ColumnResult>& results, const SpMat& Qff, const MatX& qcols,
+                       const std::vector<std::vector<char>>& outside, const std::vector<int>& support_nodes,
+                       const VecX& support_radius, int n, double t_setup, double t_active) {
+  const int C = int(results.size());
+  const int nf = int(Qff.rows());
+  BbwReport r;
+  r.num_nodes = n;
+  r.num_free = nf;
+  r.num_handles = C;
+  r.seconds_setup = t_setup;
+  r.seconds_active_set = t_active;
+  size_t hist = 0;
+  double iters = 0.0;
+  for (const auto& cr : results) {
+    hist = std::max(hist, cr.history.size());
+    r.max_iterations = std::max(r.max_iterations, cr.iterations);
+    r.max_inactive = std::max(r.max_inactive, cr.max_inactive);
+    iters += cr.iterations;
+  }
+  r.mean_iterations = C > 0 ? iters / C : 0.0;
+  double facts = 0.0;
+  for (const auto& cr : results) facts += cr.factorizations;
+  r.mean_factorizations = C > 0 ? facts / C : 0.0;
+  r.kkt_history.assign(hist, 0.0);
+  for (const auto& cr : results)
+    for (size_t i = 0; i < hist; ++i)
+      r.kkt_history[i] = std::max(r.kkt_history[i], cr.history[std::min(i, cr.history.size() - 1)]);
+  // Final residual of the returned (clamped) solutions.
+  for (int c = 0; c < C && nf > 0; ++c) {
+    const VecX& x = results[c].x;
+    const double qn = std::max(qcols.col(c).lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
+    r.kkt_residual =
+        std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn,
+                                              outside.empty() || outside[c].empty() ? nullptr : &outside[c]));
+  }
+  r.support_radius = C > 0 ? support_radius.maxCoeff() : 0.0;
+  for (int sn : support_nodes) r.max_support_nodes = std::max(r.max_support_nodes, sn);
+  return r;
+}
 
 /// bounded_biharmonic_qp with a support radius per column (m; 0 = unrestricted).
 MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_values, const VecX& support_radius,
@@ -393,12 +222,7 @@ MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_val
     std::mutex progress_mutex;
     std::atomic<int> done{0};
     auto run = [&](int c) {
-      VecX dist = VecX::Constant(nf, std::numeric_limits<double>::infinity());
-      for (int b = 0; b < fixed.size(); ++b) {
-        if (fixed_values(b, c) == 0.0) continue;
-        const Vec3 p = mesh.nodes.row(fixed(b)).transpose();
-        for (int f = 0; f < nf; ++f) dist(f) = std::min(dist(f), (mesh.nodes.row(free_nodes[f]).transpose() - p).norm());
-      }
+      const VecX dist = distances_to_sources(mesh, fixed, fixed_values.col(c), free_nodes);
       if (compact && support_radius[c] > 0.0) {
         std::vector<int> sources;
         for (int b = 0; b < fixed.size(); ++b)
@@ -418,29 +242,7 @@ MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_val
         progress.update(d);
       }
     };
-    // One worker per core pulls columns from a shared counter (TBB is not
-    // linked into basis/; the columns are independent and similar in cost).
-    std::atomic<int> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto worker = [&] {
-      for (int c; (c = next++) < C;) {
-        try {
-          run(c);
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (!error) error = std::current_exception();
-          next = C;
-        }
-      }
-    };
-    const int cores = std::max(1, int(std::thread::hardware_concurrency()));
-    const int workers = std::max(1, std::min<int>(C, options.threads > 0 ? options.threads : cores));
-    std::vector<std::thread> pool;
-    if (nf > 0)
-      for (int t = 0; t < workers; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    if (nf > 0) for_each_column_in_parallel(C, options.threads, run);
     if (options.show_progress) progress.finish();
   }
   const double t_active = timer.seconds();
@@ -450,41 +252,8 @@ MatX supported_qp(const TetMesh& mesh, const VecXi& fixed, const MatX& fixed_val
   for (int c = 0; c < C && nf > 0; ++c)
     for (int f = 0; f < nf; ++f) W(free_nodes[f], c) = results[c].x(f);
 
-  if (report) {
-    BbwReport& r = *report;
-    r = BbwReport{};
-    r.num_nodes = n;
-    r.num_free = nf;
-    r.num_handles = C;
-    r.seconds_setup = t_setup;
-    r.seconds_active_set = t_active;
-    size_t hist = 0;
-    double iters = 0.0;
-    for (const auto& cr : results) {
-      hist = std::max(hist, cr.history.size());
-      r.max_iterations = std::max(r.max_iterations, cr.iterations);
-      r.max_inactive = std::max(r.max_inactive, cr.max_inactive);
-      iters += cr.iterations;
-    }
-    r.mean_iterations = C > 0 ? iters / C : 0.0;
-    double facts = 0.0;
-    for (const auto& cr : results) facts += cr.factorizations;
-    r.mean_factorizations = C > 0 ? facts / C : 0.0;
-    r.kkt_history.assign(hist, 0.0);
-    for (const auto& cr : results)
-      for (size_t i = 0; i < hist; ++i)
-        r.kkt_history[i] = std::max(r.kkt_history[i], cr.history[std::min(i, cr.history.size() - 1)]);
-    // Final residual of the returned (clamped) solutions.
-    for (int c = 0; c < C && nf > 0; ++c) {
-      const VecX& x = results[c].x;
-      const double qn = std::max(qcols.col(c).lpNorm<Eigen::Infinity>(), std::numeric_limits<double>::min());
-      r.kkt_residual =
-          std::max(r.kkt_residual, kkt_residual(x, Qff * x + qcols.col(c), qn,
-                                                outside.empty() || outside[c].empty() ? nullptr : &outside[c]));
-    }
-    r.support_radius = C > 0 ? support_radius.maxCoeff() : 0.0;
-    for (int sn : support_nodes) r.max_support_nodes = std::max(r.max_support_nodes, sn);
-  }
+  if (report)
+    *report = solve_report(results, Qff, qcols, outside, support_nodes, support_radius, n, t_setup, t_active);
   return W;
 }
 

@@ -15,38 +15,40 @@ namespace sflsh::basis {
 namespace {
 
 using Features = std::vector<std::pair<int, double>>;  // (field index, value), sorted by index
+using RowSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-}  // namespace
+/// Lumped nodal masses of every node (nodal_cubature), one sample per node:
+/// the reference's mass model for the flesh, and the mass of the tissue that
+/// only the bones carry (it adds to their inertia when bones are dynamic).
+struct NodeMasses {
+  Cubature lumped;
+  VecX mass;                   ///< per mesh node
+  std::vector<int> nodes;      ///< the nodes with a sample, in sample order
+  std::vector<int> sample_of;  ///< per mesh node: its sample, or −1
+};
 
-Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
-                              const VecXi& node_role, const MatXr& node_weights, const VecX& tet_density,
-                              int samples_per_cell, MassFitReport* report) {
-  const int N = mesh.num_nodes(), T = mesh.num_elements(), K = int(W.cols()), B = int(node_weights.cols());
-  require(samples_per_cell >= 1, "mass_fitted_cubature: samples_per_cell must be >= 1, got ", samples_per_cell);
-  require(W.rows() == N, "mass_fitted_cubature: W has ", W.rows(), " rows, mesh has ", N, " nodes");
-  require(node_role.size() == N, "mass_fitted_cubature: node_role has ", node_role.size(), " entries, expected ", N);
-  require(node_weights.rows() == N && B > 0, "mass_fitted_cubature: node_weights is ", node_weights.rows(), " by ", B,
-          ", expected ", N, " by #bones");
-  require(tet_density.size() == T, "mass_fitted_cubature: tet_density has ", tet_density.size(), " entries, expected ",
-          T);
-
-  // Lumped nodal masses of every node (nodal_cubature), one sample per node:
-  // the reference's mass model for the flesh, and the mass of the tissue that
-  // only the bones carry (it adds to their inertia when bones are dynamic).
-  const Cubature lumped = nodal_cubature(mesh, tet_density);
-  VecX mass = VecX::Zero(N);
-  std::vector<int> nodes, sample_of(size_t(N), -1);
-  for (int s = 0; s < lumped.size(); ++s) {
+NodeMasses node_masses(const TetMesh& mesh, const VecX& tet_density) {
+  const int N = mesh.num_nodes();
+  NodeMasses m{nodal_cubature(mesh, tet_density), VecX::Zero(N), {}, std::vector<int>(size_t(N), -1)};
+  for (int s = 0; s < m.lumped.size(); ++s) {
     int corner = 0;
-    lumped.barycentric.row(s).maxCoeff(&corner);
-    const int t = lumped.elements[s], n = mesh.elements(t, corner);
-    mass[n] = tet_density[t] * lumped.weights[s];
-    nodes.push_back(n);
-    sample_of[size_t(n)] = s;
+    m.lumped.barycentric.row(s).maxCoeff(&corner);
+    const int t = m.lumped.elements[s], n = mesh.elements(t, corner);
+    m.mass[n] = tet_density[t] * m.lumped.weights[s];
+    m.nodes.push_back(n);
+    m.sample_of[size_t(n)] = s;
   }
-  require(!nodes.empty(), "mass_fitted_cubature: the mesh has no tets");
+  return m;
+}
 
-  // Bone centroids c_b, then each node's fields.
+/// Each node's fields (K + 4B of them): its handle weights (Simulated nodes),
+/// and per bone b its weight and the weight times its offset from the bone
+/// centroid c_b.
+std::vector<Features> node_fields(const TetMesh& mesh, const RowSparse& W, const VecXi& node_role,
+                                  const MatXr& node_weights, const NodeMasses& m) {
+  const int K = int(W.cols()), B = int(node_weights.cols());
+  const VecX& mass = m.mass;
+  const std::vector<int>& nodes = m.nodes;
   Points centroid = Points::Zero(B, 3);
   VecX bone_mass = VecX::Zero(B);
   for (int n : nodes)
@@ -56,7 +58,6 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
     }
   for (int b = 0; b < B; ++b)
     if (bone_mass[b] > 0) centroid.row(b) /= bone_mass[b];
-  const int F = K + 4 * B;
   auto features = [&](int n) {
     Features f;
     if (node_role[n] == int(NodeRole::Simulated))
@@ -73,9 +74,26 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
   };
   std::vector<Features> field(nodes.size());
   for (size_t i = 0; i < nodes.size(); ++i) field[i] = features(nodes[i]);
+  return field;
+}
 
-  // Moments M_ab (a ≤ b) and their equation rows.
-  std::vector<double> moment(size_t(F) * F, 0.0);
+/// The moments M_ab (a ≤ b) of the F fields over the nodes, and the equation
+/// row of each (−1: none; rows need both fields' M_aa > 0).
+struct Moments {
+  int F = 0, rows = 0;
+  std::vector<double> moment;  ///< F × F, row a, column b
+  std::vector<int> row_of;     ///< F × F
+  /// 1 / sqrt(M_aa M_bb): the normalization of row (a, b).
+  double pair_scale(int a, int b) const { return 1.0 / std::sqrt(moment[size_t(a) * F + a] * moment[size_t(b) * F + b]); }
+};
+
+Moments field_moments(const std::vector<Features>& field, const NodeMasses& m, int F) {
+  const VecX& mass = m.mass;
+  const std::vector<int>& nodes = m.nodes;
+  Moments out;
+  out.F = F;
+  std::vector<double>& moment = out.moment;
+  moment.assign(size_t(F) * F, 0.0);
   std::vector<char> used(size_t(F) * F, 0);
   for (size_t i = 0; i < nodes.size(); ++i) {
     const Features& f = field[i];
@@ -86,16 +104,25 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
         used[key] = 1;
       }
   }
-  std::vector<int> row_of(size_t(F) * F, -1);
-  int rows = 0;
+  std::vector<int>& row_of = out.row_of;
+  row_of.assign(size_t(F) * F, -1);
+  int& rows = out.rows;
   for (size_t key = 0; key < used.size(); ++key)
     if (used[key] && moment[size_t(key / F) * F + key / F] > 0 && moment[size_t(key % F) * F + key % F] > 0)
       row_of[key] = rows++;
-  auto pair_scale = [&](int a, int b) {
-    return 1.0 / std::sqrt(moment[size_t(a) * F + a] * moment[size_t(b) * F + b]);
-  };
+  return out;
+}
 
-  // Candidates: per cell, farthest-point nodes; initial mass = cell mass / count.
+/// Candidates (indices into m.nodes): per cell (the node's dominant handle,
+/// else its dominant bone), farthest-point nodes; initial mass = cell mass / count.
+void cell_candidates(const TetMesh& mesh, const RowSparse& W, const VecXi& node_role, const MatXr& node_weights,
+                     const NodeMasses& m, int samples_per_cell, std::vector<int>* candidate_out,
+                     std::vector<double>* initial_out) {
+  const int K = int(W.cols());
+  const VecX& mass = m.mass;
+  const std::vector<int>& nodes = m.nodes;
+  std::vector<int>& candidate = *candidate_out;
+  std::vector<double>& initial = *initial_out;
   std::map<int, std::vector<int>> cells;  // label -> indices into `nodes`
   for (size_t i = 0; i < nodes.size(); ++i) {
     const int n = nodes[i];
@@ -115,8 +142,6 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
     }
     cells[label].push_back(int(i));
   }
-  std::vector<int> candidate;  // indices into `nodes`
-  std::vector<double> initial;
   for (const auto& [label, members] : cells) {
     Points p(Eigen::Index(members.size()), 3);
     double cell_mass = 0;
@@ -130,6 +155,41 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
       initial.push_back(cell_mass / double(chosen.size()));
     }
   }
+}
+
+}  // namespace
+
+Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<double, Eigen::RowMajor>& W,
+                              const VecXi& node_role, const MatXr& node_weights, const VecX& tet_density,
+                              int samples_per_cell, MassFitReport* report) {
+  const int N = mesh.num_nodes(), T = mesh.num_elements(), K = int(W.cols()), B = int(node_weights.cols());
+  require(samples_per_cell >= 1, "mass_fitted_cubature: samples_per_cell must be >= 1, got ", samples_per_cell);
+  require(W.rows() == N, "mass_fitted_cubature: W has ", W.rows(), " rows, mesh has ", N, " nodes");
+  require(node_role.size() == N, "mass_fitted_cubature: node_role has ", node_role.size(), " entries, expected ", N);
+  require(node_weights.rows() == N && B > 0, "mass_fitted_cubature: node_weights is ", node_weights.rows(), " by ", B,
+          ", expected ", N, " by #bones");
+  require(tet_density.size() == T, "mass_fitted_cubature: tet_density has ", tet_density.size(), " entries, expected ",
+          T);
+
+  const NodeMasses masses = node_masses(mesh, tet_density);
+  const Cubature& lumped = masses.lumped;
+  const VecX& mass = masses.mass;
+  const std::vector<int>& nodes = masses.nodes;
+  const std::vector<int>& sample_of = masses.sample_of;
+  require(!nodes.empty(), "mass_fitted_cubature: the mesh has no tets");
+
+  // Each node's fields, their moments and the equation rows.
+  const int F = K + 4 * B;
+  const std::vector<Features> field = node_fields(mesh, W, node_role, node_weights, masses);
+  const Moments moments = field_moments(field, masses, F);
+  const std::vector<double>& moment = moments.moment;
+  const std::vector<int>& row_of = moments.row_of;
+  const int rows = moments.rows;
+  auto pair_scale = [&](int a, int b) { return moments.pair_scale(a, b); };
+
+  std::vector<int> candidate;  // indices into `nodes`
+  std::vector<double> initial;
+  cell_candidates(mesh, W, node_role, node_weights, masses, samples_per_cell, &candidate, &initial);
   const int n = int(candidate.size());
 
   // Equations A c = b: the normalized moment rows, then the total mass (weight 3).
@@ -140,7 +200,7 @@ Cubature mass_fitted_cubature(const TetMesh& mesh, const Eigen::SparseMatrix<dou
   }();
   constexpr double kMassRowWeight = 30.0;
   VecX b = VecX::Zero(rows + 1);
-  for (size_t key = 0; key < used.size(); ++key)
+  for (size_t key = 0; key < row_of.size(); ++key)
     if (row_of[key] >= 0) b[row_of[key]] = pair_scale(int(key / F), int(key % F)) * moment[key];
   b[rows] = kMassRowWeight;
   std::vector<Eigen::Triplet<double>> entries;

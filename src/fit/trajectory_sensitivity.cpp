@@ -62,6 +62,38 @@ void assemble(const Model& model, const Avatar& avatar, const Configuration& ite
   }
 }
 
+/// What the sensitivity propagation starts from: the elastic term's parameter
+/// derivatives, K (the elastic Hessian at rest: exactly the quadratic part;
+/// damping's K₀) and the inertia samples' skinning rotations at t = −h and 0.
+struct SensitivityStart {
+  std::unique_ptr<ElasticSensitivity> elastic;
+  std::vector<int> elastic_index;
+  MatX K;
+  const InertiaTerm* inertia = nullptr;
+  std::vector<Mat3> A_prev, A_cur;
+};
+
+SensitivityStart start_sensitivity(const Model& model, const Avatar& av, const FitParameters& params,
+                                   const BoneSequence& seq) {
+  const int n = av.num_reduced();
+  SensitivityStart st;
+  st.inertia = model.find_term<InertiaTerm>(0);
+  require(st.inertia != nullptr, "simulate_surface: the model has no inertia term");
+  const ElasticTerm* elastic = model.find_term<ElasticTerm>(0);
+  require(elastic != nullptr, "simulate_surface: the model has no elastic term");
+  st.elastic = std::make_unique<ElasticSensitivity>(av, params.elastic(&st.elastic_index), elastic->mean_dilatation());
+  StepContext ctx;
+  ctx.avatar = &av;
+  ctx.layout = model.bodies()[0].layout;
+  Configuration rest{seq.bones[0], VecX::Zero(n)};
+  VecX g0 = VecX::Zero(n);
+  st.K = MatX::Zero(n, n);
+  elastic->evaluate(ctx, rest, &g0, &st.K);
+  st.A_prev = skinning_rotations(st.inertia->points(), seq.bones_before);
+  st.A_cur = skinning_rotations(st.inertia->points(), seq.bones[0]);
+  return st;
+}
+
 }  // namespace
 
 SurfaceRun simulate_surface(const Avatar& avatar, const FitParameters& params, const VecX& p, double damping,
@@ -105,29 +137,20 @@ SurfaceRun simulate_surface(const Avatar& avatar, const FitParameters& params, c
 
   SurfaceRun out;
   // Sensitivity state.
-  std::unique_ptr<ElasticSensitivity> es;
-  std::vector<int> elastic_index;
-  MatX K, S = MatX::Zero(n, P), S_prev = MatX::Zero(n, P);
-  const InertiaTerm* inertia = model.find_term<InertiaTerm>(0);
-  std::vector<Mat3> A_prev, A_cur;  // inertia samples' skinning rotations at t − h and t
+  SensitivityStart start;
+  start.inertia = model.find_term<InertiaTerm>(0);
   if (jacobian) {
     Timer timer;
-    require(inertia != nullptr, "simulate_surface: the model has no inertia term");
-    // K: the elastic Hessian at rest (exactly the quadratic part; damping's K₀).
-    const ElasticTerm* elastic = model.find_term<ElasticTerm>(0);
-    require(elastic != nullptr, "simulate_surface: the model has no elastic term");
-    es = std::make_unique<ElasticSensitivity>(*av, params.elastic(&elastic_index), elastic->mean_dilatation());
-    StepContext ctx;
-    ctx.avatar = av.get();
-    ctx.layout = model.bodies()[0].layout;
-    Configuration rest{seq.bones[0], VecX::Zero(n)};
-    VecX g0 = VecX::Zero(n);
-    K = MatX::Zero(n, n);
-    elastic->evaluate(ctx, rest, &g0, &K);
-    A_prev = skinning_rotations(inertia->points(), seq.bones_before);
-    A_cur = skinning_rotations(inertia->points(), seq.bones[0]);
+    start = start_sensitivity(model, *av, params, seq);
     out.ms_sensitivity += timer.ms();
   }
+  std::unique_ptr<ElasticSensitivity>& es = start.elastic;
+  const std::vector<int>& elastic_index = start.elastic_index;
+  const MatX& K = start.K;
+  const InertiaTerm* inertia = start.inertia;
+  std::vector<Mat3>& A_prev = start.A_prev;  // inertia samples' skinning rotations at t − h and t
+  std::vector<Mat3>& A_cur = start.A_cur;
+  MatX S = MatX::Zero(n, P), S_prev = MatX::Zero(n, P);
 
   size_t next = 0;
   auto record = [&](int s) {

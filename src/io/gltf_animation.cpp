@@ -159,6 +159,32 @@ void check_rigid_node(const std::string& path, const GltfRigidNode& n, size_t nu
   require(n.color.allFinite(), at, ": colour must be finite");
 }
 
+/// Writes a GLB container (spec §4.4): 12-byte header, JSON chunk padded with
+/// spaces, BIN chunk padded with zeros, both to 4 bytes.
+void write_glb(const std::string& path, std::string json, std::string bin) {
+  json.append((4 - json.size() % 4) % 4, ' ');
+  bin.append((4 - bin.size() % 4) % 4, '\0');
+  std::string glb;
+  put_u32(glb, 0x46546C67u);  // "glTF"
+  put_u32(glb, 2);
+  put_u32(glb, std::uint32_t(12 + 8 + json.size() + 8 + bin.size()));
+  put_u32(glb, std::uint32_t(json.size()));
+  put_u32(glb, 0x4E4F534Au);  // "JSON"
+  AtomicOutput out(path);
+  std::ofstream os(out.temp_path(), std::ios::binary);
+  require(bool(os), path, ": cannot open ", out.temp_path(), " for writing");
+  os.write(glb.data(), std::streamsize(glb.size()));
+  os.write(json.data(), std::streamsize(json.size()));
+  std::string bin_header;
+  put_u32(bin_header, std::uint32_t(bin.size()));
+  put_u32(bin_header, 0x004E4942u);  // "BIN\0"
+  os.write(bin_header.data(), 8);
+  os.write(bin.data(), std::streamsize(bin.size()));
+  os.close();
+  require(bool(os), path, ": write failed (disk full?)");
+  out.commit();
+}
+
 }  // namespace
 
 void write_animated_glb(const std::string& path, const std::vector<Points>& frames, const Triangles& F, double fps,
@@ -258,31 +284,7 @@ void write_animated_glb(const std::string& path, const std::vector<Points>& fram
   js << ",\"buffers\":[{\"byteLength\":" << buf.bin().size() << "}],\"bufferViews\":" << buf.views_json()
      << ",\"accessors\":" << buf.accessors_json() << "}";
 
-  // GLB container (spec §4.4): 12-byte header, JSON chunk padded with spaces,
-  // BIN chunk padded with zeros, both to 4 bytes.
-  std::string json = js.str();
-  json.append((4 - json.size() % 4) % 4, ' ');
-  std::string bin = buf.bin();
-  bin.append((4 - bin.size() % 4) % 4, '\0');
-  std::string glb;
-  put_u32(glb, 0x46546C67u);  // "glTF"
-  put_u32(glb, 2);
-  put_u32(glb, std::uint32_t(12 + 8 + json.size() + 8 + bin.size()));
-  put_u32(glb, std::uint32_t(json.size()));
-  put_u32(glb, 0x4E4F534Au);  // "JSON"
-  AtomicOutput out(path);
-  std::ofstream os(out.temp_path(), std::ios::binary);
-  require(bool(os), path, ": cannot open ", out.temp_path(), " for writing");
-  os.write(glb.data(), std::streamsize(glb.size()));
-  os.write(json.data(), std::streamsize(json.size()));
-  std::string bin_header;
-  put_u32(bin_header, std::uint32_t(bin.size()));
-  put_u32(bin_header, 0x004E4942u);  // "BIN\0"
-  os.write(bin_header.data(), 8);
-  os.write(bin.data(), std::streamsize(bin.size()));
-  os.close();
-  require(bool(os), path, ": write failed (disk full?)");
-  out.commit();
+  write_glb(path, js.str(), buf.bin());
 }
 
 }  // namespace sflsh::io

@@ -42,18 +42,24 @@ std::int64_t read_integer(const unsigned char* p, int bytes, bool is_signed, boo
   return std::int64_t(v);
 }
 
-}  // namespace
-
-void check_ply_structure(std::string_view bytes, const std::string& path) {
-  if (bytes.substr(0, 3) != "ply") return;
-  // The header is lines, each starting with one of PLY's keywords, up to a line that is
-  // exactly "end_header". A damaged keyword, or "end_header" inside another line, made this
-  // walk and assimp's disagree on where the body starts: assimp then ran out of bounds or
-  // looped for minutes (scripts/fuzz.sh, mesh). So every line is checked, not searched.
+/// A PLY header: its format, elements and where the body starts.
+struct PlyHeader {
   std::string format;
   std::vector<Element> elements;
+  std::size_t body = std::string_view::npos;
+};
+
+/// Reads the header: lines, each starting with one of PLY's keywords, up to a line that is
+/// exactly "end_header". A damaged keyword, or "end_header" inside another line, made this
+/// walk and assimp's disagree on where the body starts: assimp then ran out of bounds or
+/// looped for minutes (scripts/fuzz.sh, mesh). So every line is checked, not searched.
+PlyHeader read_ply_header(std::string_view bytes, const std::string& path) {
+  PlyHeader h;
+  std::string& format = h.format;
+  std::vector<Element>& elements = h.elements;
+  std::size_t& body = h.body;
   int line_no = 0;
-  std::size_t at_line = 0, body = std::string_view::npos;
+  std::size_t at_line = 0;
   while (at_line < bytes.size()) {
     const std::size_t nl = bytes.find('\n', at_line);
     require(nl != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
@@ -111,18 +117,20 @@ void check_ply_structure(std::string_view bytes, const std::string& path) {
               "', not a PLY keyword (ply, format, comment, obj_info, element, property, end_header): a damaged file?");
     }
   }
-  require(body != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
-  require(format == "ascii" || format == "binary_little_endian" || format == "binary_big_endian", path,
-          ": PLY header has no known format line (got '", format, "')");
-  if (format == "ascii") return;  // assimp's text parser stops at the end of the text
+  return h;
+}
 
-  const bool big_endian = format == "binary_big_endian";
+/// Walks a binary PLY body: every element's rows fit in the bytes left, list
+/// counts are non-negative and faces refer to existing vertices.
+void check_ply_body(std::string_view bytes, const std::string& path, const PlyHeader& h) {
+  const std::vector<Element>& elements = h.elements;
+  const bool big_endian = h.format == "binary_big_endian";
   std::uint64_t num_vertices = 0;
   for (const Element& e : elements)
     if (e.name == "vertex") num_vertices = e.count;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const std::size_t size = bytes.size();
-  std::size_t at = body;
+  std::size_t at = h.body;
   for (const Element& e : elements) {
     bool has_list = false;
     std::size_t fixed = 0;
@@ -164,6 +172,21 @@ void check_ply_structure(std::string_view bytes, const std::string& path) {
       }
     }
   }
+}
+
+}  // namespace
+
+void check_ply_structure(std::string_view bytes, const std::string& path) {
+  if (bytes.substr(0, 3) != "ply") return;
+  const PlyHeader h = read_ply_header(bytes, path);
+  const std::size_t body = h.body;
+  const std::string& format = h.format;
+  require(body != std::string_view::npos, path, ": PLY header without an end_header line (truncated file?)");
+  require(format == "ascii" || format == "binary_little_endian" || format == "binary_big_endian", path,
+          ": PLY header has no known format line (got '", format, "')");
+  if (format == "ascii") return;  // assimp's text parser stops at the end of the text
+
+  check_ply_body(bytes, path, h);
 }
 
 }  // namespace sflsh::io

@@ -84,6 +84,43 @@ std::string SurfaceReport::describe() const {
   return os.str();
 }
 
+namespace {
+
+/// Whether the link of vertex v (the edges opposite to it in its faces `fan`)
+/// is one connected path or cycle.
+bool link_is_one_piece(const Triangles& F, int v, const std::vector<int>& fan) {
+  std::vector<std::pair<int, int>> link;  // opposite edge per face
+  std::vector<int> nodes;
+  for (int f : fan) {
+    int k = 0;
+    while (F(f, k) != v) ++k;
+    const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
+    link.emplace_back(a, b);
+    nodes.push_back(a);
+    nodes.push_back(b);
+  }
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  DisjointSets link_sets(int(nodes.size()));
+  std::vector<int> degree(nodes.size(), 0);
+  auto local = [&](int x) { return int(std::lower_bound(nodes.begin(), nodes.end(), x) - nodes.begin()); };
+  for (const auto& [a, b] : link) {
+    const int la = local(a), lb = local(b);
+    link_sets.unite(la, lb);
+    ++degree[la];
+    ++degree[lb];
+  }
+  int parts = 0;
+  bool ok = true;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (link_sets.find(int(i)) == int(i)) ++parts;
+    if (degree[i] > 2) ok = false;
+  }
+  return parts == 1 && ok;
+}
+
+}  // namespace
+
 SurfaceReport check_surface(const Points& V, const Triangles& F, bool test_self_intersection) {
   SurfaceReport r;
   r.num_vertices = int(V.rows());
@@ -142,34 +179,7 @@ SurfaceReport check_surface(const Points& V, const Triangles& F, bool test_self_
       ++r.num_unreferenced_vertices;
       continue;
     }
-    std::vector<std::pair<int, int>> link;  // opposite edge per face
-    std::vector<int> nodes;
-    for (int f : fan) {
-      int k = 0;
-      while (F(f, k) != v) ++k;
-      const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
-      link.emplace_back(a, b);
-      nodes.push_back(a);
-      nodes.push_back(b);
-    }
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    DisjointSets link_sets(int(nodes.size()));
-    std::vector<int> degree(nodes.size(), 0);
-    auto local = [&](int x) { return int(std::lower_bound(nodes.begin(), nodes.end(), x) - nodes.begin()); };
-    for (const auto& [a, b] : link) {
-      const int la = local(a), lb = local(b);
-      link_sets.unite(la, lb);
-      ++degree[la];
-      ++degree[lb];
-    }
-    int parts = 0;
-    bool ok = true;
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      if (link_sets.find(int(i)) == int(i)) ++parts;
-      if (degree[i] > 2) ok = false;
-    }
-    if (parts != 1 || !ok) ++r.num_nonmanifold_vertices;
+    if (!link_is_one_piece(F, v, fan)) ++r.num_nonmanifold_vertices;
   }
 
   r.is_closed = r.num_faces > 0 && r.num_boundary_edges == 0 && r.num_nonmanifold_edges == 0;

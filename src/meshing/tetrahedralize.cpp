@@ -120,6 +120,111 @@ struct ScaledField {
   }
 };
 
+/// Mesh_3 criteria: uniform unless a sizing field is given (CGAL picks the
+/// variable-size criterion from the argument type). `one` (the unit field)
+/// must outlive the criteria.
+Criteria mesh_criteria(const TetrahedralizeOptions& o, const std::function<double(const Vec3&)>& one) {
+  namespace p = CGAL::parameters;
+  const auto* size_scale = o.size_scale ? &o.size_scale : &one;
+  const auto* distance_scale = o.distance_scale ? &o.distance_scale : &one;
+  return (o.size_scale || o.distance_scale)
+             ? Criteria(Criteria::Edge_criteria(DBL_MAX),
+                        Criteria::Facet_criteria(o.facet_angle_deg, ScaledField{o.facet_size, size_scale},
+                                                 ScaledField{o.facet_distance, distance_scale}),
+                        Criteria::Cell_criteria(o.cell_radius_edge_ratio, ScaledField{o.cell_size, size_scale}))
+             : Criteria(p::facet_angle = o.facet_angle_deg, p::facet_size = o.facet_size,
+                        p::facet_distance = o.facet_distance, p::cell_radius_edge_ratio = o.cell_radius_edge_ratio,
+                        p::cell_size = o.cell_size);
+}
+
+/// Inserts Mesh_3's own initial points (random rays from the box centre, as
+/// make_mesh_3 does) plus the bisected seed pairs as surface vertices: the
+/// seeds reach every boundary component (the rays can miss an inner one).
+void seed_surface(C3t3& c3t3, const Domain& domain, const Points& seed_inside, const Points& seed_outside) {
+  std::vector<std::pair<K::Point_3, Domain::Index>> initial;
+  domain.construct_initial_points_object()(std::back_inserter(initial));
+  auto intersect = domain.construct_intersection_object();
+  for (int i = 0; i < seed_inside.rows(); ++i) {
+    const K::Point_3 a(seed_inside(i, 0), seed_inside(i, 1), seed_inside(i, 2));
+    const K::Point_3 b(seed_outside(i, 0), seed_outside(i, 1), seed_outside(i, 2));
+    const auto hit = intersect(K::Segment_3(a, b));
+    if (std::get<2>(hit) != 0) initial.emplace_back(std::get<0>(hit), std::get<1>(hit));
+  }
+  Tr& tr = c3t3.triangulation();
+  auto cwp = tr.geom_traits().construct_weighted_point_3_object();
+  for (const auto& [pt, idx] : initial) {
+    const auto v = tr.insert(cwp(pt));
+    if (v == Tr::Vertex_handle()) continue;  // hidden point
+    c3t3.set_dimension(v, 2);
+    c3t3.set_index(v, idx);
+  }
+}
+
+/// ODT smoothing, sliver perturbation and exudation, as the options ask; times in `rep`.
+void optimize_mesh(C3t3& c3t3, const Domain& domain, const TetrahedralizeOptions& o, TetrahedralizeReport& rep) {
+  namespace p = CGAL::parameters;
+  Timer timer;
+  if (o.odt_iterations > 0) {
+    // ODT smoothing (bounded iteration count, no time limit: deterministic)
+    // evens out the vertex distribution, which leaves far fewer slivers for
+    // the expensive perturbation step.
+    CGAL::odt_optimize_mesh_3(c3t3, domain, p::time_limit = 0, p::max_iteration_number = o.odt_iterations,
+                              p::convergence = 0.02, p::freeze_bound = 0.01);
+  }
+  rep.odt_s = timer.seconds();
+  timer.reset();
+  if (o.perturb_sliver_bound_deg > 0) {
+    // CGAL's perturb_mesh_3 with its default strategies minus most of the
+    // last one: the random (Li) perturbation, 100 trials per vertex, is what
+    // makes perturbation take minutes on a thin shell where slivers span the
+    // layer, each trial costing domain projections. Gradient moves first, a
+    // few random trials last.
+    using Criterion = CGAL::Mesh_3::Min_dihedral_angle_criterion<Tr>;
+    using Perturber = CGAL::Mesh_3::Sliver_perturber<C3t3, Domain, Criterion>;
+    Criterion criterion(o.perturb_sliver_bound_deg, c3t3.triangulation());
+    Perturber perturber(c3t3, domain, criterion);
+    perturber.add_perturbation(new CGAL::Mesh_3::Sq_radius_perturbation<C3t3, Domain, Criterion>(40, 0.05));
+    perturber.add_perturbation(new CGAL::Mesh_3::Volume_perturbation<C3t3, Domain, Criterion>(40, 0.05));
+    perturber.add_perturbation(new CGAL::Mesh_3::Dihedral_angle_perturbation<C3t3, Domain, Criterion>(40, 0.05));
+    if (o.perturb_random_trials > 0)
+      perturber.add_perturbation(
+          new CGAL::Mesh_3::Li_random_perturbation<C3t3, Domain, Criterion>(o.perturb_random_trials, 0.15));
+    perturber.set_time_limit(o.perturb_time_limit_s);
+    rep.perturb_time_limit_reached = (perturber() == CGAL::TIME_LIMIT_REACHED);
+  }
+  rep.perturb_s = timer.seconds();
+  timer.reset();
+  if (o.exude_sliver_bound_deg > 0)
+    CGAL::exude_mesh_3(c3t3, p::time_limit = o.exude_time_limit_s, p::sliver_bound = o.exude_sliver_bound_deg);
+  rep.exude_s = timer.seconds();
+}
+
+/// The mesh of the complex: nodes in the order CGAL stores them, cells in the complex.
+TetMesh extract_mesh(const C3t3& c3t3) {
+  TetMesh mesh;
+  const Tr& tr = c3t3.triangulation();
+  std::unordered_map<Tr::Vertex_handle, int> index;
+  std::vector<Vec3> pts;
+  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v) {
+    index[v] = int(pts.size());
+    const auto& pt = tr.point(v);
+    pts.emplace_back(pt.x(), pt.y(), pt.z());
+  }
+  mesh.nodes.resize(pts.size(), 3);
+  for (size_t i = 0; i < pts.size(); ++i) mesh.nodes.row(i) = pts[i].transpose();
+  std::vector<std::array<int, 4>> cells;
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
+    cells.push_back({index.at(c->vertex(0)), index.at(c->vertex(1)), index.at(c->vertex(2)),
+                     index.at(c->vertex(3))});
+  require(!cells.empty(), "tetrahedralize_implicit: Mesh_3 produced no tets (region empty or missed; ",
+          "check the inside function, the box and the seeds)");
+  mesh.elements.resize(cells.size(), 4);
+  for (size_t t = 0; t < cells.size(); ++t)
+    for (int i = 0; i < 4; ++i) mesh.elements(t, i) = cells[t][i];
+
+  return mesh;
+}
+
 }  // namespace
 
 TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, const Vec3& box_min,
@@ -154,45 +259,12 @@ TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, 
   Domain domain(p::function = label, p::bounding_object = box,
                 p::relative_error_bound = o.relative_error_bound, p::p_rng = &domain_rng);
 
-  // Uniform criteria unless a sizing field is given (CGAL picks the
-  // variable-size criterion from the argument type).
+  // Uniform criteria unless a sizing field is given (mesh_criteria).
   const std::function<double(const Vec3&)> one = [](const Vec3&) { return 1.0; };
-  const auto* size_scale = o.size_scale ? &o.size_scale : &one;
-  const auto* distance_scale = o.distance_scale ? &o.distance_scale : &one;
-  const Criteria criteria =
-      (o.size_scale || o.distance_scale)
-          ? Criteria(Criteria::Edge_criteria(DBL_MAX),
-                     Criteria::Facet_criteria(o.facet_angle_deg, ScaledField{o.facet_size, size_scale},
-                                              ScaledField{o.facet_distance, distance_scale}),
-                     Criteria::Cell_criteria(o.cell_radius_edge_ratio, ScaledField{o.cell_size, size_scale}))
-          : Criteria(p::facet_angle = o.facet_angle_deg, p::facet_size = o.facet_size,
-                     p::facet_distance = o.facet_distance, p::cell_radius_edge_ratio = o.cell_radius_edge_ratio,
-                     p::cell_size = o.cell_size);
+  const Criteria criteria = mesh_criteria(o, one);
 
   C3t3 c3t3;
-  {
-    // Seed every boundary component (Mesh_3's own random rays from the box
-    // centre can miss an inner component entirely).
-    // Mesh_3's own initial points (random rays, as make_mesh_3 does) plus the
-    // bisected seed pairs, all inserted as surface vertices.
-    std::vector<std::pair<K::Point_3, Domain::Index>> initial;
-    domain.construct_initial_points_object()(std::back_inserter(initial));
-    auto intersect = domain.construct_intersection_object();
-    for (int i = 0; i < seed_inside.rows(); ++i) {
-      const K::Point_3 a(seed_inside(i, 0), seed_inside(i, 1), seed_inside(i, 2));
-      const K::Point_3 b(seed_outside(i, 0), seed_outside(i, 1), seed_outside(i, 2));
-      const auto hit = intersect(K::Segment_3(a, b));
-      if (std::get<2>(hit) != 0) initial.emplace_back(std::get<0>(hit), std::get<1>(hit));
-    }
-    Tr& tr = c3t3.triangulation();
-    auto cwp = tr.geom_traits().construct_weighted_point_3_object();
-    for (const auto& [pt, idx] : initial) {
-      const auto v = tr.insert(cwp(pt));
-      if (v == Tr::Vertex_handle()) continue;  // hidden point
-      c3t3.set_dimension(v, 2);
-      c3t3.set_index(v, idx);
-    }
-  }
+  seed_surface(c3t3, domain, seed_inside, seed_outside);
   Timer timer;
   // A vertex budget turns runaway refinement (criteria the surface cannot
   // meet, or a broken inside test) into one clear error instead of a hang.
@@ -208,63 +280,9 @@ TetMesh tetrahedralize_implicit(const std::function<bool(const Vec3&)>& inside, 
           " (facet_distance ", o.facet_distance, " m, facet_size ", o.facet_size, " m, cell_size ", o.cell_size,
           " m, facet_angle ", o.facet_angle_deg,
           " deg); loosen facet_distance or the sizes, or check that the region is bounded by the box");
-  timer.reset();
-  if (o.odt_iterations > 0) {
-    // ODT smoothing (bounded iteration count, no time limit: deterministic)
-    // evens out the vertex distribution, which leaves far fewer slivers for
-    // the expensive perturbation step.
-    CGAL::odt_optimize_mesh_3(c3t3, domain, p::time_limit = 0, p::max_iteration_number = o.odt_iterations,
-                              p::convergence = 0.02, p::freeze_bound = 0.01);
-  }
-  rep.odt_s = timer.seconds();
-  timer.reset();
-  if (o.perturb_sliver_bound_deg > 0) {
-    // CGAL's perturb_mesh_3 with its default strategies minus most of the
-    // last one: the random (Li) perturbation, 100 trials per vertex, is what
-    // makes perturbation take minutes on a thin shell where slivers span the
-    // layer, each trial costing domain projections. Gradient moves first, a
-    // few random trials last.
-    using Criterion = CGAL::Mesh_3::Min_dihedral_angle_criterion<Tr>;
-    using Perturber = CGAL::Mesh_3::Sliver_perturber<C3t3, Domain, Criterion>;
-    Criterion criterion(o.perturb_sliver_bound_deg, c3t3.triangulation());
-    Perturber perturber(c3t3, domain, criterion);
-    perturber.add_perturbation(new CGAL::Mesh_3::Sq_radius_perturbation<C3t3, Domain, Criterion>(40, 0.05));
-    perturber.add_perturbation(new CGAL::Mesh_3::Volume_perturbation<C3t3, Domain, Criterion>(40, 0.05));
-    perturber.add_perturbation(new CGAL::Mesh_3::Dihedral_angle_perturbation<C3t3, Domain, Criterion>(40, 0.05));
-    if (o.perturb_random_trials > 0)
-      perturber.add_perturbation(
-          new CGAL::Mesh_3::Li_random_perturbation<C3t3, Domain, Criterion>(o.perturb_random_trials, 0.15));
-    perturber.set_time_limit(o.perturb_time_limit_s);
-    rep.perturb_time_limit_reached = (perturber() == CGAL::TIME_LIMIT_REACHED);
-  }
-  rep.perturb_s = timer.seconds();
-  timer.reset();
-  if (o.exude_sliver_bound_deg > 0)
-    CGAL::exude_mesh_3(c3t3, p::time_limit = o.exude_time_limit_s, p::sliver_bound = o.exude_sliver_bound_deg);
-  rep.exude_s = timer.seconds();
+  optimize_mesh(c3t3, domain, o, rep);
 
-  // Extract: nodes in the order CGAL stores them, cells in the complex.
-  TetMesh mesh;
-  const Tr& tr = c3t3.triangulation();
-  std::unordered_map<Tr::Vertex_handle, int> index;
-  std::vector<Vec3> pts;
-  for (auto v = tr.finite_vertices_begin(); v != tr.finite_vertices_end(); ++v) {
-    index[v] = int(pts.size());
-    const auto& pt = tr.point(v);
-    pts.emplace_back(pt.x(), pt.y(), pt.z());
-  }
-  mesh.nodes.resize(pts.size(), 3);
-  for (size_t i = 0; i < pts.size(); ++i) mesh.nodes.row(i) = pts[i].transpose();
-  std::vector<std::array<int, 4>> cells;
-  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c)
-    cells.push_back({index.at(c->vertex(0)), index.at(c->vertex(1)), index.at(c->vertex(2)),
-                     index.at(c->vertex(3))});
-  require(!cells.empty(), "tetrahedralize_implicit: Mesh_3 produced no tets (region empty or missed; ",
-          "check the inside function, the box and the seeds)");
-  mesh.elements.resize(cells.size(), 4);
-  for (size_t t = 0; t < cells.size(); ++t)
-    for (int i = 0; i < 4; ++i) mesh.elements(t, i) = cells[t][i];
-
+  TetMesh mesh = extract_mesh(c3t3);
   rep.flipped = orient_tets_positively(mesh);
   if (o.remove_boundary_slivers_below_deg > 0)
     rep.removed_boundary_slivers = remove_boundary_slivers(mesh, o.remove_boundary_slivers_below_deg);

@@ -194,16 +194,12 @@ double metres_per_unit(const std::string& units) {
   fail("unknown length unit '", units, "' (expected auto, m, cm, mm, inch or cmu)");
 }
 
-MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const RetargetOptions& options,
-                            RetargetReport* report) {
-  const int nj = m.num_joints();
-  require(nj > 0 && m.num_frames > 0, m.source, ": the file holds no animated skeleton");
-  require(m.fps > 0 && std::isfinite(m.fps), m.source, ": frame rate must be positive, got ", m.fps);
-  const Points rest = options.rest_joints.rows() ? options.rest_joints : default_smpl_rest_joints();
-  require(rest.rows() == kSmplJoints && rest.allFinite(), "retargeting: rest joints must be a finite 24 by 3 array, got ",
-          rest.rows(), " rows");
+namespace {
 
-  // SMPL joint -> source joint.
+/// SMPL joint -> source joint of `m` (−1: unmapped) by the joint map; the
+/// pelvis must be mapped.
+std::vector<int> source_joints(const SkeletonMotion& m, const JointMap& map) {
+  const int nj = m.num_joints();
   std::vector<int> joint_of(kSmplJoints, -1);
   for (const auto& [name, j] : map.entries) {
     const int b = find_joint(m, name);
@@ -218,8 +214,12 @@ MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const 
          expected, "'); the file's joints are: ", names, nj > 40 ? ", ..." : "",
          ". Pass a joint map (--joint-map FILE with 'file_joint smpl_joint' lines)");
   }
-  // Nearest mapped SMPL ancestor of each joint (its source joint must be an
-  // ancestor of ours, else the map contradicts the file's tree).
+  return joint_of;
+}
+
+/// Nearest mapped SMPL ancestor of each joint (its source joint must be an
+/// ancestor of ours, else the map contradicts the file's tree).
+std::vector<int> mapped_parents(const SkeletonMotion& m, const JointMap& map, const std::vector<int>& joint_of) {
   std::vector<int> mapped_parent(kSmplJoints, -1);
   for (int j = 1; j < kSmplJoints; ++j) {
     int a = kSmplParents[j];
@@ -230,24 +230,13 @@ MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const 
               m.names[joint_of[j]], "' (SMPL ", kSmplJointNames[j], ") is not below '", m.names[joint_of[a]],
               "' (SMPL ", kSmplJointNames[a], ") in the file's hierarchy");
   }
+  return mapped_parent;
+}
 
-  std::vector<Quat> rest_rot, rot;
-  std::vector<Vec3> rest_pos, pos;
-  skeleton_world_pose(m, -1, &rest_rot, &rest_pos);
-  std::vector<Vec3> smpl_rest(kSmplJoints);
-  for (int j = 0; j < kSmplJoints; ++j) smpl_rest[j] = rest.row(j).transpose();
-
-  // Size of the source (file units) and of the avatar (metres): leg lengths,
-  // or heights when the legs are not mapped.
-  std::vector<int> identity(kSmplJoints);
-  for (int j = 0; j < kSmplJoints; ++j) identity[j] = j;
-  double size_src = leg_length(rest_pos, joint_of), size_smpl = leg_length(smpl_rest, identity);
-  if (size_src <= 0) {
-    size_src = height_span(rest_pos);
-    size_smpl = height_span(smpl_rest);
-  }
-  require(size_src > 0 && std::isfinite(size_src), m.source, ": the rest skeleton has zero size");
-  std::string units = options.units;
+/// The length unit of the source: `requested`, or with "auto" the one that makes
+/// its size (file units) closest to the avatar's (m).
+std::string source_units(const std::string& requested, double size_src, double size_smpl) {
+  std::string units = requested;
   if (units == "auto") {
     double best = 1e300;
     for (const char* u : {"m", "cm", "mm", "inch", "cmu"}) {
@@ -258,11 +247,15 @@ MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const 
       }
     }
   }
-  const double unit = metres_per_unit(units);
-  const double avatar_scale = size_smpl / (size_src * unit);
-  const double k = unit * avatar_scale;
+  return units;
+}
 
-  // Rest alignment C_j (see header).
+/// Rest alignment C_j (see header): per SMPL joint, the rotation of its rest
+/// bone onto the source's (through zero-length source bones), else its mapped parent's.
+std::vector<Quat> rest_alignment(const SkeletonMotion& m, const std::vector<int>& joint_of,
+                                 const std::vector<int>& mapped_parent, const std::vector<Vec3>& rest_pos,
+                                 const std::vector<Vec3>& smpl_rest, double size_src) {
+  const int nj = m.num_joints();
   std::vector<std::vector<int>> children(nj);
   for (int j = 0; j < nj; ++j)
     if (m.parents[j] >= 0) children[m.parents[j]].push_back(j);
@@ -283,6 +276,71 @@ MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const 
     if (d.norm() <= eps || e.norm() <= 1e-9) continue;
     C[j] = Quat::FromTwoVectors(e, d);
   }
+  return C;
+}
+
+/// What the retargeting mapped, ignored and left undriven, and its units and scale.
+void report_retarget(const SkeletonMotion& m, const JointMap& map, const std::vector<int>& joint_of,
+                     const std::string& units, double unit, double avatar_scale, RetargetReport* report) {
+  const int nj = m.num_joints();
+  report->map_name = map.name;
+  report->mapped.clear();
+  report->ignored.clear();
+  report->undriven.clear();
+  std::vector<bool> used(nj, false);
+  for (int j = 0; j < kSmplJoints; ++j) {
+    if (joint_of[j] >= 0) {
+      used[joint_of[j]] = true;
+      report->mapped.push_back(m.names[joint_of[j]] + " -> " + std::string(kSmplJointNames[j]));
+    } else {
+      report->undriven.emplace_back(kSmplJointNames[j]);
+    }
+  }
+  for (int b = 0; b < nj; ++b)
+    if (!used[b] && m.animated[b]) report->ignored.push_back(m.names[b]);
+  report->units = units;
+  report->metres_per_unit = unit;
+  report->avatar_scale = avatar_scale;
+}
+
+}  // namespace
+
+MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const RetargetOptions& options,
+                            RetargetReport* report) {
+  const int nj = m.num_joints();
+  require(nj > 0 && m.num_frames > 0, m.source, ": the file holds no animated skeleton");
+  require(m.fps > 0 && std::isfinite(m.fps), m.source, ": frame rate must be positive, got ", m.fps);
+  const Points rest = options.rest_joints.rows() ? options.rest_joints : default_smpl_rest_joints();
+  require(rest.rows() == kSmplJoints && rest.allFinite(), "retargeting: rest joints must be a finite 24 by 3 array, got ",
+          rest.rows(), " rows");
+
+  // SMPL joint -> source joint; the nearest mapped SMPL ancestor of each joint.
+  const std::vector<int> joint_of = source_joints(m, map);
+  const std::vector<int> mapped_parent = mapped_parents(m, map, joint_of);
+
+  std::vector<Quat> rest_rot, rot;
+  std::vector<Vec3> rest_pos, pos;
+  skeleton_world_pose(m, -1, &rest_rot, &rest_pos);
+  std::vector<Vec3> smpl_rest(kSmplJoints);
+  for (int j = 0; j < kSmplJoints; ++j) smpl_rest[j] = rest.row(j).transpose();
+
+  // Size of the source (file units) and of the avatar (metres): leg lengths,
+  // or heights when the legs are not mapped.
+  std::vector<int> identity(kSmplJoints);
+  for (int j = 0; j < kSmplJoints; ++j) identity[j] = j;
+  double size_src = leg_length(rest_pos, joint_of), size_smpl = leg_length(smpl_rest, identity);
+  if (size_src <= 0) {
+    size_src = height_span(rest_pos);
+    size_smpl = height_span(smpl_rest);
+  }
+  require(size_src > 0 && std::isfinite(size_src), m.source, ": the rest skeleton has zero size");
+  const std::string units = source_units(options.units, size_src, size_smpl);
+  const double unit = metres_per_unit(units);
+  const double avatar_scale = size_smpl / (size_src * unit);
+  const double k = unit * avatar_scale;
+
+  // Rest alignment C_j (see header).
+  const std::vector<Quat> C = rest_alignment(m, joint_of, mapped_parent, rest_pos, smpl_rest, size_src);
 
   MotionClip clip;
   clip.name = m.source;
@@ -311,26 +369,7 @@ MotionClip retarget_to_smpl(const SkeletonMotion& m, const JointMap& map, const 
     for (auto& t : clip.translations) t -= t0;
   }
 
-  if (report) {
-    report->map_name = map.name;
-    report->mapped.clear();
-    report->ignored.clear();
-    report->undriven.clear();
-    std::vector<bool> used(nj, false);
-    for (int j = 0; j < kSmplJoints; ++j) {
-      if (joint_of[j] >= 0) {
-        used[joint_of[j]] = true;
-        report->mapped.push_back(m.names[joint_of[j]] + " -> " + std::string(kSmplJointNames[j]));
-      } else {
-        report->undriven.emplace_back(kSmplJointNames[j]);
-      }
-    }
-    for (int b = 0; b < nj; ++b)
-      if (!used[b] && m.animated[b]) report->ignored.push_back(m.names[b]);
-    report->units = units;
-    report->metres_per_unit = unit;
-    report->avatar_scale = avatar_scale;
-  }
+  if (report) report_retarget(m, map, joint_of, units, unit, avatar_scale, report);
   return clip;
 }
 

@@ -27,6 +27,20 @@ T get(std::string_view in, std::size_t* at, const char* field) {
   return v;
 }
 
+/// Every tool's pose (position, then the quaternion w x y z), force, torque and closure.
+nlohmann::json tools_json(const std::vector<ToolFrame>& tools) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const ToolFrame& t : tools) {
+    const Vec3 p = t.pose.translation();
+    const Eigen::Quaterniond q(t.pose.rotation());
+    a.push_back({{"pose", {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}},
+                 {"force", {t.force.x(), t.force.y(), t.force.z()}},
+                 {"torque", {t.torque.x(), t.torque.y(), t.torque.z()}},
+                 {"closure", t.closure}});
+  }
+  return a;
+}
+
 std::string info_json(const ViewerFrame& f, const FrameEnvelope& e) {
   const ViewerStats& s = f.stats;
   nlohmann::json j;
@@ -54,6 +68,7 @@ std::string info_json(const ViewerFrame& f, const FrameEnvelope& e) {
                  {"closure", s.closure},
                  {"contact", s.contact},
                  {"anchors", s.anchors}};
+  if (!f.tools.empty()) j["tools"] = tools_json(f.tools);
   return j.dump();
 }
 

@@ -54,13 +54,18 @@ ViewerScene viewer_scene(const SimulationResult& r, const std::vector<std::strin
   for (const std::string& t : tool_names) {
     s.tools.push_back(t);
     int found = -1;
-    for (size_t o = 0; o < s.objects.size(); ++o)
-      if (s.objects[o].name == t) {
+    for (size_t o = 0; o < s.objects.size(); ++o) {
+      const std::string& name = s.objects[o].name;
+      if (name == t) {
         found = int(o);
         s.objects[o].kind = "tool";
+      } else if (name.rfind(t + "/jaw", 0) == 0) {
+        s.objects[o].kind = "tool";  // a jaw of the tool's gripper (its pose opens with the closure)
       }
+    }
     s.tool_objects.push_back(found);
   }
+  s.tool_events = r.tool_events;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   double umax = 0;
   for (size_t f = 0; f < r.frame_positions.size(); ++f) {
@@ -79,6 +84,15 @@ ViewerScene viewer_scene(const SimulationResult& r, const std::vector<std::strin
   s.legend_max = std::max(min_legend, std::ceil(umax * 1e3) * 1e-3);
   s.duration = r.frame_time.empty() ? 0.0 : r.frame_time.back();
   s.dt = r.dt;
+  return s;
+}
+
+ViewerScene playback_scene(const SimulationResult& r, const std::string& title) {
+  std::vector<std::string> tools;
+  for (const ToolTrack& t : r.tools) tools.push_back(t.name);
+  ViewerScene s = viewer_scene(r, tools, 0.05, 0.001);
+  s.mode = "playback";
+  s.title = title;
   return s;
 }
 
@@ -109,6 +123,10 @@ std::string scene_json(const ViewerScene& s) {
   j["duration"] = s.duration;
   j["dt"] = s.dt;
   j["can_reset"] = s.can_reset;
+  json events = json::array();
+  for (const ToolEvent& e : s.tool_events)
+    events.push_back({{"time", e.time}, {"tool", e.tool}, {"body", e.body}, {"kind", e.kind}, {"points", e.points}});
+  j["tool_events"] = events;
   return j.dump();
 }
 

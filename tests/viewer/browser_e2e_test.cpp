@@ -6,7 +6,7 @@
 // is not blank; then the panel's controls: the stiffness slider reaches the
 // server, pause holds, step takes one solver step, reset goes back to t = 0
 // (tool at its start, no displacement). And `sflsh view` plays a result
-// file: the time advances.
+// file: the time advances, and the result's tool reaches the page.
 // Skips with a message when chromium, node or apps/viewer/node_modules is
 // absent (scripts/setup.sh installs them).
 #include <gtest/gtest.h>
@@ -185,6 +185,10 @@ TEST_F(BrowserE2E, ViewPlaysAResultFile) {
   EXPECT_NE(out.find("\"ok\":true"), std::string::npos) << out;
   // Playing at speed 0.25 for 1 s moves the clock by about 0.25 s.
   EXPECT_GT(number_after(out, "\"t_after\":"), 0.1) << out;
+  // The probe reaches the page: in every frame, and as a row of the tools panel.
+  EXPECT_NE(out.find("\"tools_in_frame\":1"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"tool_rows\":1"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"tools_panel\":true"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Playback (`sflsh view`): the frame shown at time t is the result file's
 // frame at time t (the last frame at or before t), through the server and a
-// WebSocket client, to within the 16-bit quantization of positions.
+// WebSocket client, to within the 16-bit quantization of positions; the
+// result's tools (pose, force, torque, closure per frame, grasp events) reach
+// the page with the values the file holds.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -40,6 +42,39 @@ SimulationResult four_frames() {
     r.add_step(0.1 * k, StepReport{});
   }
   r.num_frames = 4;
+  return r;
+}
+
+// four_frames with two tools: "grip", drawn by an object of its name and a jaw
+// object "grip/jaw0", and "probe" without a surface; distinct values per frame
+// k and tool, and a grasp and a release.
+SimulationResult four_frames_with_tools() {
+  SimulationResult r = four_frames();
+  const ViewerScene s = test::tiny_scene();
+  ObjectTrack grip{"grip", "sphere", "kinematic", s.rest, s.faces, {}};
+  ObjectTrack jaw{"grip/jaw0", "box", "kinematic", s.rest, s.faces, {}};
+  ToolTrack grip_tool{"grip", {}}, probe_tool{"probe", {}};
+  for (int k = 0; k < 4; ++k) {
+    ToolFrame g;
+    g.pose = Isometry::Identity();
+    g.pose.linear() = Eigen::AngleAxisd(0.1 * k + 0.05, Vec3::UnitZ()).toRotationMatrix();
+    g.pose.translation() = Vec3(0.1 + 0.01 * k, 0.2, 0.3);
+    g.closure = 0.05 + 0.1 * k;
+    g.force = Vec3(1.0 + k, -2.0, 0.5);
+    g.torque = Vec3(0.01, 0.02 * k, -0.03);
+    grip_tool.frames.push_back(g);
+    ToolFrame p;
+    p.pose.translation() = Vec3(-0.2, 0.1 * k, 0.0);
+    p.force = Vec3(0.0, 0.0, 3.0 * k + 0.25);
+    probe_tool.frames.push_back(p);
+    grip.poses.push_back(g.pose);
+    Isometry jaw_pose = g.pose;
+    jaw_pose.translation().x() += 0.001 * k;
+    jaw.poses.push_back(jaw_pose);
+  }
+  r.objects = {grip, jaw};
+  r.tools = {grip_tool, probe_tool};
+  r.tool_events = {{0.1, "grip", "body", "grasp", 5}, {0.3, "grip", "body", "release", 4}};
   return r;
 }
 
@@ -110,6 +145,65 @@ TEST(ResultPlayer, TheFrameShownAtTimeTIsTheFilesFrameAtT) {
     EXPECT_NEAR(d.displacement[0], 0.001 * k, 0.003 / 255) << "t " << t;  // legend 3 mm in 8 bits
     EXPECT_EQ(nlohmann::json::parse(d.info)["frame"], k) << "t " << t;
     EXPECT_NEAR(d.time, t, 1e-12);
+  }
+}
+
+TEST(ResultPlayer, TheResultsToolsReachThePageWithTheFilesValues) {
+  if (!web_assets_problem().empty()) GTEST_SKIP() << web_assets_problem();
+  sflsh::test::TempDir dir;
+  const SimulationResult written = four_frames_with_tools();
+  write_simulation_result(written, dir.file("r.h5"));
+  const SimulationResult r = read_simulation_result(dir.file("r.h5"));
+  ViewerServerOptions o;
+  o.port = 0;
+  o.quiet = true;
+  ViewerServer server(playback_scene(r, "r.h5"), o);
+  ResultPlayer player(r);
+  test::Client client(server.port());
+  bool text = false;
+  const nlohmann::json scene = nlohmann::json::parse(client.read(&text));
+  ASSERT_TRUE(text);
+  EXPECT_EQ(scene["mode"], "playback");
+  ASSERT_EQ(scene["tools"].size(), 2u);
+  EXPECT_EQ(scene["tools"][0]["name"], "grip");
+  EXPECT_EQ(scene["tools"][0]["object"], 0);
+  EXPECT_EQ(scene["tools"][1]["name"], "probe");
+  EXPECT_EQ(scene["tools"][1]["object"], -1);  // no surface: the page draws a marker
+  EXPECT_EQ(scene["objects"][0]["kind"], "tool");
+  EXPECT_EQ(scene["objects"][1]["kind"], "tool");  // the jaw
+  ASSERT_EQ(scene["tool_events"].size(), 2u);
+  EXPECT_EQ(scene["tool_events"][0]["kind"], "grasp");
+  EXPECT_EQ(scene["tool_events"][0]["tool"], "grip");
+  EXPECT_EQ(scene["tool_events"][0]["body"], "body");
+  EXPECT_EQ(scene["tool_events"][0]["points"], 5);
+  EXPECT_DOUBLE_EQ(scene["tool_events"][1]["time"].get<double>(), 0.3);
+  EXPECT_EQ(scene["tool_events"][1]["kind"], "release");
+  QuantizedSkin state;
+  for (int k : {2, 0, 3}) {
+    ControlMessage seek;
+    seek.type = ControlType::kSeek;
+    seek.value = 0.1 * k;
+    player.apply(seek);
+    server.publish(player.current());
+    const DecodedFrame d = decode_frame(client.read(), server.scene(), &state);
+    const nlohmann::json tools = nlohmann::json::parse(d.info)["tools"];
+    ASSERT_EQ(tools.size(), 2u) << "frame " << k;
+    for (size_t t = 0; t < 2; ++t) {
+      const ToolFrame& w = written.tools[t].frames[size_t(k)];
+      const nlohmann::json& g = tools[t];
+      const Eigen::Quaterniond q(w.pose.rotation());
+      const double pose[7] = {w.pose.translation().x(), w.pose.translation().y(), w.pose.translation().z(),
+                              q.w(), q.x(), q.y(), q.z()};
+      for (int c = 0; c < 7; ++c) EXPECT_NEAR(g["pose"][c].get<double>(), pose[c], 1e-12) << "frame " << k << " tool " << t;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_DOUBLE_EQ(g["force"][c].get<double>(), w.force[c]) << "frame " << k << " tool " << t;
+        EXPECT_DOUBLE_EQ(g["torque"][c].get<double>(), w.torque[c]) << "frame " << k << " tool " << t;
+      }
+      EXPECT_DOUBLE_EQ(g["closure"].get<double>(), w.closure) << "frame " << k << " tool " << t;
+    }
+    // The grip's surface and its jaw are posed by the frame's object poses.
+    ASSERT_EQ(d.object_poses.size(), 2u);
+    EXPECT_LE((d.object_poses[1].translation() - written.objects[1].poses[size_t(k)].translation()).norm(), 1e-6);
   }
 }
 

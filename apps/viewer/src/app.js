@@ -7,6 +7,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { decodeFrame, makeState } from './protocol.js';
 import { ForcePlot, colormap, drawLegend } from './panels.js';
 import { ToolInput } from './tool_input.js';
+import { ResultTools } from './result_tools.js';
 
 const $ = (id) => document.getElementById(id);
 // SMPL joint parents (24 joints per body).
@@ -64,6 +65,7 @@ let ws = null, meta = null, skin = null, state = null, skeleton = null, dirty = 
 let faces = null, skinDirty = false;  // skinDirty: positions changed since the last draw (normals due)
 const objects = [];
 let toolInput = null, plot = null, arrow = null, driver = false, paused = false;
+let resultTools = null;  // playback: the result's tools
 let seq = 0;
 let lastResets = 0, stiffnessSentAt = -1e9;
 const sentAt = new Map();  // seq -> performance.now() at send, for input-to-photon
@@ -156,6 +158,11 @@ function buildScene(m) {
     toolInput = new ToolInput({ camera, dom: renderer.domElement, orbit, send, toolMesh: objects[m.tools[0].object],
                                 toolModeBox: $('toolmode') });
   }
+  if (!live && m.tools.length > 0) {
+    $('resulttools').classList.remove('hidden');
+    resultTools = new ResultTools({ scene3, meta: m, objects, table: $('tooltable'), events: $('toolevents'),
+                                    seek: (t) => send({ type: 'seek', time: t }) });
+  }
   dirty = true;
 }
 
@@ -241,6 +248,7 @@ function applyFrame(f) {
 // updates cost style, layout and paint of the side panel).
 let panelsAt = -1e9;
 function showInfo(info) {
+  if (resultTools && info.tools) resultTools.show(info.tools);
   if (info.tool) {
     const F = new THREE.Vector3(...info.tool.force), n = F.length();
     if (plot) plot.push(info.t, info.tool.force);
@@ -286,6 +294,7 @@ function showPanels(info) {
     const b = tr.insertCell(); b.style.width = '80px';
     b.innerHTML = `<div class="bar" style="width:${(100 * ms / total).toFixed(0)}%"></div>`;
   }
+  if (resultTools && info.tools) resultTools.panel(info.tools, info.t);
   if (info.tool) {
     const n = Math.hypot(...info.tool.force);
     $('force').textContent = `${n.toFixed(2)} (${info.tool.force.map((x) => x.toFixed(2)).join(', ')})`;

@@ -8,8 +8,8 @@
 // in the view plane, holds, and reports what the server sent (contact, max |u|);
 // with --controls, then moves the stiffness slider to 10^0.5 ≈ 3.16×, pauses, steps, resets
 // and resumes with the page's controls and reports what the frames said;
-// playback: presses play and checks the time advances. Always: display fps,
-// bandwidth, input-to-photon latencies, pixel statistics of the rendered image.
+// playback: presses play and checks the time advances, and reports the result's tools.
+// Always: display fps, bandwidth, input-to-photon latencies, pixel statistics of the rendered image.
 // Prints one JSON line; exits 1 when the page shows no frames or is blank.
 import fs from 'node:fs';
 import os from 'node:os';
@@ -133,6 +133,11 @@ try {
     await sleep(seconds * 1000);
     const last = await info();
     Object.assign(result, { t_before: first.t, t_after: last.t, frame_after: last.frame });
+    // The result's tools: in the frames, and in the page's tool panel.
+    const panel = await page.evaluate(() => ({ rows: document.querySelectorAll('#tooltable tr').length,
+                                               shown: !document.getElementById('resulttools').classList.contains('hidden') }));
+    Object.assign(result, { tools_in_frame: (last.tools || []).length, tool_rows: panel.rows, tools_panel: panel.shown,
+                            tool_pose: last.tools && last.tools.length ? last.tools[0].pose : null });
   }
   const s = await page.evaluate(() => {
     const v = window.sflshViewer, l = v.latencies.slice().sort((a, b) => a - b);

@@ -24,7 +24,9 @@
 //          12J  joints    float32 x y z
 //           L   info      UTF-8 JSON: {"t","seq","driver","clients","paused","rtf","step_ms",
 //                         "terms":[[name, ms]...],"stiffness","resets","steps","max_u_mm","frame","speed",
-//                         "tool":{"force":[N],"device":[m],"quat":[w,x,y,z],"closure","contact","anchors"}}
+//                         "tool":{"force":[N],"device":[m],"quat":[w,x,y,z],"closure","contact","anchors"},
+//                         "tools":[{"pose":[px,py,pz,qw,qx,qy,qz],"force":[N],"torque":[N·m],"closure"}]}
+//                         ("tool": the driven tool, live; "tools": every tool, playback)
 // 16-bit positions keep a 2 m box to 0.03 mm and the default avatar (~9k
 // vertices) at 63 kB per full frame (1.9 MB/s at 30 fps); deltas are smaller
 // whenever part of the skin is still.
@@ -34,6 +36,7 @@
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/scene/simulation_run.hpp"
 #include "sflsh/sim/configuration.hpp"
 #include "sflsh/viewer/viewer_scene.hpp"
 
@@ -73,6 +76,7 @@ struct ViewerFrame {
   VecX displacement;            ///< #V soft displacement magnitudes |u| (m)
   Points joints;                ///< #J by 3 (m, world); may be empty
   std::vector<Isometry> object_poses;  ///< one per ViewerScene object
+  std::vector<ToolFrame> tools;        ///< playback: one per ViewerScene tool (pose, closure, force, torque)
   ViewerStats stats;
 };
 

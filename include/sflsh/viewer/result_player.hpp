@@ -14,7 +14,8 @@ namespace sflsh::viewer {
 /// (to within 1e-9 s); frame 0 before the first. `frame_time` ascending, not empty.
 int frame_at(const std::vector<double>& frame_time, double t);
 
-/// Result frame `f` as a viewer frame: positions, |u| per vertex, joints, object poses.
+/// Result frame `f` as a viewer frame: positions, |u| per vertex, joints, object poses,
+/// every tool's pose, closure, force and torque.
 ViewerFrame result_frame(const SimulationResult& result, int f);
 
 class ResultPlayer {
