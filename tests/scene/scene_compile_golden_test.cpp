@@ -339,10 +339,14 @@ TEST_F(SceneCompileGolden, ContactPatchWithKinematicAndCoupledTools) {
   // The states re-pinned when the patch came to subtract what the subspace
   // holds of its tets and samples instead of their exact energy
   // (contact_patch.hpp, "What the patch subtracts"); the term list and the layout did not change.
+  // Re-pinned again when the step inputs went by id: the same arithmetic, but
+  // the compiler's fused multiply-adds in the patch's evaluation moved (its
+  // object code changed with StepContext's), so the state differs by round-off
+  // (after 20 steps at most 1.5e-12 relative in z, 8e-13 in the forces).
   check({kPatchScene, nullptr, 20,
          {"inertia@0; elastic@0; gravity@0; contact:floor@0; contact:probe@0; bone_inertia@1; coupling:pusher@1; contact:pusher@0,1",
           "base:0/24/18@0 pusher:1/1/0@18 dofs 24 blocks 2 groups 1",
-          "26531cbf85fad2a5", "fdd7bc2f27b1eaf6", "11c58e244baa6a84", 0}});
+          "c112cba7ada5e569", "4952ab161c9239c0", "0ce28e954668927e", 0}});
 }
 
 TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
