@@ -1,6 +1,7 @@
 // The benchmark's runs along a motion: the full-FEM reference, the reduced
 // simulator, skinning alone and the Bullet peer, each recorded as a Trace.
 #include "bench/benchmark_internal.hpp"
+#include "sflsh/core/timer.hpp"
 
 namespace sflsh::bench_internal {
 
@@ -63,13 +64,6 @@ double reset_peak_rss_mib() {
   while (std::getline(f, line))
     if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
   return kNaN;
-}
-
-/// CPU time of the calling thread (ms).
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
 }
 
 }  // namespace

@@ -114,6 +114,8 @@ std::vector<CompiledObject> add_objects(ModelBuilder& mb, const SceneDescription
     if (o.desc->kind == ObjectKind::Dynamic) {
       o.model_index = mb.add_body({o.desc->name, nullptr, true});
       add_rigid_body_terms(mb, o.model_index, o.model.mass.mass, o.model.mass.inertia);
+    } else {
+      o.frame = mb.add_frame(o.desc->name);
     }
   }
   return objects;
@@ -123,7 +125,8 @@ std::vector<CompiledObject> add_objects(ModelBuilder& mb, const SceneDescription
 /// its pressure patch, else the per-skin-sample penalty with friction. The
 /// shape is the world frame `frame` (static or kinematic) or, `dynamic`, the
 /// rigid body `shape_body` of the model with the shape at `shape_in_body`.
-void add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::string& frame,
+/// Returns the term's model index.
+int add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::string& frame,
                        const geometry::SdfPtr& field, const Isometry& shape_in_body, bool dynamic, int shape_body,
                        bool patch, const ContactDescription& c, SkinSamples& samples) {
   std::shared_ptr<const EnergyTerm> term;
@@ -141,10 +144,8 @@ void add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::strin
     co.friction = c.friction;
     term = std::make_shared<const SdfContactTerm>(frame, *pts, field, shape_in_body, dynamic, co);
   }
-  if (dynamic)
-    mb.add_term(term, {b.model_index, shape_body});
-  else
-    mb.add_term(term, {b.model_index});
+  if (dynamic) return mb.add_term(term, {b.model_index, shape_body});
+  return mb.add_term(term, {b.model_index});
 }
 
 /// Adds one contact term per colliding body–object pair.
@@ -176,12 +177,11 @@ RigidObjectModel tool_shape(const std::string& name, const ShapeDescription& sha
 /// contact with every body through its shape and jaws (with contact.patch a
 /// kinematic tool gets the face-sampled contact, a coupled one keeps the
 /// per-sample penalty); with sensors one anchor term per body for grasping.
+/// Records the tool's input ids and the terms that act on it.
 CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vector<CompiledBody>& bodies,
                       const ContactDescription& c, SkinSamples& samples) {
   CompiledTool t;
   t.desc = &d;
-  t.contact_term = "contact:" + d.name;
-  t.anchor_prefix = "anchor:" + d.name + "@";
   if (d.coupled) {
     const ToolCouplingDescription& cd = d.coupling;
     // The tool body: a solid sphere of radius 2 cm of the coupling's mass
@@ -194,13 +194,15 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
     t.coupling.damping = cd.damping >= 0 ? cd.damping : 2.0 * std::sqrt(cd.stiffness * cd.mass);
     t.coupling.rotational_damping =
         cd.rotational_damping >= 0 ? cd.rotational_damping : 2.0 * std::sqrt(cd.rotational_stiffness * inertia);
-    mb.add_term(std::make_shared<const VirtualCouplingTerm>(d.name, t.coupling), {t.model_index});
+    t.coupling_term = mb.add_term(std::make_shared<const VirtualCouplingTerm>(d.name, t.coupling), {t.model_index});
   }
   const bool coupled = t.coupled();
+  t.frame = mb.add_frame(coupled ? device_frame_name(d.name) : d.name);
   for (size_t j = 0; j < d.jaws.size(); ++j) {
     CompiledJaw jaw{d.name + "/jaw" + std::to_string(j), {}, Isometry::Identity(), d.jaws[j].side};
     jaw.model = tool_shape(jaw.name, d.jaws[j].shape);
     jaw.offset.translation() = d.jaws[j].offset;
+    jaw.frame = mb.add_frame(coupled ? moving_shape_frame_name(jaw.name) : jaw.name);
     t.jaws.push_back(std::move(jaw));
   }
   if (d.has_shape) t.shape = tool_shape(d.name, d.shape);
@@ -209,18 +211,18 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
   const bool patch = c.patch && !coupled;
   for (const CompiledBody& b : bodies) {
     if (d.has_shape)
-      add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled, t.model_index, patch, c, samples);
+      t.contact_terms.push_back(add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled,
+                                                  t.model_index, patch, c, samples));
     for (const CompiledJaw& jaw : t.jaws)
-      add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled, t.model_index, patch, c,
-                        samples);
+      t.contact_terms.push_back(add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled,
+                                                  t.model_index, patch, c, samples));
     if (d.sensors.empty()) continue;
-    t.anchor_keys.push_back(d.name + "@" + b.desc->name);
-    auto term = std::make_shared<const AnchorTerm>(t.anchor_keys.back(), PosedPoints::at_surface(*b.avatar), coupled,
+    const std::string anchor_set = d.name + "@" + b.desc->name;
+    auto term = std::make_shared<const AnchorTerm>(anchor_set, PosedPoints::at_surface(*b.avatar), coupled,
                                                    AnchorOptions{d.hardness, d.damping});
-    if (coupled)
-      mb.add_term(term, {b.model_index, t.model_index});
-    else
-      mb.add_term(term, {b.model_index});
+    t.anchor_terms.push_back(coupled ? mb.add_term(term, {b.model_index, t.model_index})
+                                     : mb.add_term(term, {b.model_index}));
+    t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
   }
   return t;
 }
@@ -346,6 +348,9 @@ std::shared_ptr<const Model> model_with_stiffness(const std::shared_ptr<const Mo
     for (int t : bodies[i].stiffness_terms) term_scale[size_t(t)] = scales[i];
   ModelBuilder mb(base->options());
   for (const Model::Body& b : base->bodies()) mb.add_body({b.name, b.avatar, b.bones_dynamic});
+  // The same input ids: frames and anchor sets first, in their order.
+  for (const std::string& f : base->frame_names()) mb.add_frame(f);
+  for (const std::string& a : base->anchor_set_names()) mb.add_anchor_set(a);
   for (size_t i = 0; i < base->terms().size(); ++i) {
     const Model::BoundTerm& t = base->terms()[i];
     const double s = term_scale[i];

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
@@ -68,6 +69,13 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
   SceneContactStats st;
   st.momentum_start = linear_momentum(sim.model(), sim.scene_state());
   std::map<std::pair<std::string, int>, size_t> pair_index;
+  // Tools' anchors and couplings: reported in tool_steps, not as contact pairs.
+  std::set<int> tool_terms;
+  for (int i = 0; i < session.num_tools(); ++i) {
+    const CompiledTool& t = session.compiled_tool(i);
+    tool_terms.insert(t.anchor_terms.begin(), t.anchor_terms.end());
+    if (t.coupling_term >= 0) tool_terms.insert(t.coupling_term);
+  }
   const double frame_dt = 1.0 / sc.output.fps;
   double next_frame = frame_dt, ms_since_frame = 0;
   int steps_since_frame = 0;
@@ -92,8 +100,7 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
     // Contact figures from the terms' reports.
     for (SceneContactStats::Pair& p : st.pairs) p.last_force.setZero();  // inactive terms report nothing
     for (const TermQuantityReport& q : rep.quantities) {
-      // Tools' anchors and couplings: in tool_steps.
-      if (q.term.rfind("anchor:", 0) == 0 || q.term.rfind("coupling:", 0) == 0) continue;
+      if (tool_terms.count(q.term_index)) continue;
       const auto key = std::make_pair(q.term, q.body);
       auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
       if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});

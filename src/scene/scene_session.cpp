@@ -85,7 +85,7 @@ const StepReport& SceneSession::advance() {
   }
   for (const CompiledObject& o : cs.objects) {
     if (o.model_index >= 0) continue;
-    m.in.frames[o.desc->name] = frame_between(object_pose_at(*o.desc, t - h), object_pose_at(*o.desc, t), h);
+    m.in.frames[o.frame] = frame_between(object_pose_at(*o.desc, t - h), object_pose_at(*o.desc, t), h);
   }
   for (ToolDriver& tool : m.tools) tool.drive(sim, cs.bodies, t, h, m.in, m.events);
   m.report = sim.step(m.in);
@@ -132,6 +132,7 @@ int SceneSession::tool_index(const std::string& name) const {
   fail(impl_->sc.path, ": no tool named '", name, "' (tools: ", known.empty() ? "none" : known, ")");
 }
 const SceneToolState& SceneSession::tool_state(int tool) const { return impl_->tools.at(tool).state(); }
+const CompiledTool& SceneSession::compiled_tool(int tool) const { return impl_->tools.at(tool).tool(); }
 void SceneSession::set_device_pose(int tool, const teleop::PoseSample& sample) { impl_->tools.at(tool).push(sample); }
 int SceneSession::stream_port(int tool) const { return impl_->tools.at(tool).stream_port(); }
 std::string SceneSession::stream_counters(int tool) const { return impl_->tools.at(tool).stream_counters(); }

@@ -38,6 +38,10 @@ bool same_sample(const PoseSample& a, const PoseSample& b) {
 
 Vec3 vec3_of(const std::vector<double>& v) { return Vec3(v[0], v[1], v[2]); }
 
+bool contains(const std::vector<int>& terms, int term) {
+  return std::find(terms.begin(), terms.end(), term) != terms.end();
+}
+
 }  // namespace
 
 ToolDriver::ToolDriver(const CompiledTool& tool, int num_bodies, const ToolDriverOptions& options)
@@ -155,17 +159,17 @@ void ToolDriver::drive(Simulator& sim, const std::vector<CompiledBody>& bodies, 
                                 : linear ? track_->at(t) : track_->at(t, PoseInterpolation::kHold);
   const WorldFrame f = frame_between(sample_pose(now), sample_pose(next), h);
   const bool coupled = tl.coupled();
-  in.frames[coupled ? device_frame_name(name()) : name()] = f;
+  in.frames[tl.frame] = f;
   // Where the jaws are at t − h: the coupled body, or the device.
   WorldFrame jaws = f;
   if (coupled) jaws = WorldFrame{sim.state(tl.model_index).bones[0]};
   const Isometry before = coupled ? jaws.pose : sample_pose(now);
   for (const CompiledJaw& jaw : tl.jaws) {
     if (coupled) {
-      in.frames[moving_shape_frame_name(jaw.name)] = WorldFrame{before * tl.jaw_in_tool(jaw, next.closure)};
+      in.frames[jaw.frame] = WorldFrame{before * tl.jaw_in_tool(jaw, next.closure)};
     } else {
-      in.frames[jaw.name] = frame_between(before * tl.jaw_in_tool(jaw, now.closure),
-                                          sample_pose(next) * tl.jaw_in_tool(jaw, next.closure), h);
+      in.frames[jaw.frame] = frame_between(before * tl.jaw_in_tool(jaw, now.closure),
+                                           sample_pose(next) * tl.jaw_in_tool(jaw, next.closure), h);
     }
   }
   for (size_t bi = 0; bi < grasps_.size(); ++bi) {
@@ -178,7 +182,9 @@ void ToolDriver::drive(Simulator& sim, const std::vector<CompiledBody>& bodies, 
       events.push_back({ev.time, name(), b.desc->name, ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release",
                         int(ev.points.size())});
     }
-    add_anchor_frames(tl.anchor_keys[bi], jaws, grasp.anchors(), coupled, in.frames);
+    const size_t set = size_t(tl.anchor_sets[bi].index);
+    if (in.anchors.size() <= set) in.anchors.resize(set + 1);
+    anchor_points(jaws, grasp.anchors(), coupled, in.anchors[set]);
   }
   if (recorder_ && !same_sample(next, recorded_)) {
     recorder_->record({0, next, t});
@@ -197,8 +203,8 @@ void ToolDriver::feel(const Simulator& sim, const StepReport& rep, double t) {
   ts.anchors = 0;
   ts.max_stretch = 0;
   for (const TermQuantityReport& q : rep.quantities) {
-    const bool contact = q.term == tl.contact_term || q.term.rfind(tl.contact_term + "/jaw", 0) == 0;
-    const bool anchor = q.term.rfind(tl.anchor_prefix, 0) == 0;
+    const bool contact = contains(tl.contact_terms, q.term_index);
+    const bool anchor = contains(tl.anchor_terms, q.term_index);
     if ((contact || anchor) && q.name == "force" && q.value.size() == 3) ts.force -= vec3_of(q.value);
     if (anchor && q.name == "anchor_points") ts.anchors += int(q.value.size());
     if (anchor && q.name == "max_stretch") ts.max_stretch = std::max(ts.max_stretch, q.value[0]);
@@ -207,9 +213,8 @@ void ToolDriver::feel(const Simulator& sim, const StepReport& rep, double t) {
   ts.pose = pose(sim);
   if (tl.coupled()) {
     // The device feels the coupling's pull, opposite to its force on the tool.
-    const std::string coupling = "coupling:" + name();
     for (const TermQuantityReport& q : rep.quantities) {
-      if (q.term != coupling) continue;
+      if (q.term_index != tl.coupling_term) continue;
       if (q.name == "force") ts.feedback_force = -vec3_of(q.value);
       if (q.name == "torque") ts.feedback_torque = -vec3_of(q.value);
     }

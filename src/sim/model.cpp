@@ -19,6 +19,36 @@ int Model::body_index(const std::string& name) const {
   fail("unknown body '", name, "'; the model has: ", known);
 }
 
+namespace {
+
+/// Index of `name` in `names`, or −1.
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : int(it - names.begin());
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
+FrameId Model::find_frame(const std::string& name) const { return FrameId{index_of(frame_names_, name)}; }
+
+FrameId Model::frame_id(const std::string& name) const {
+  const FrameId id = find_frame(name);
+  require(id.valid(), "unknown world frame '", name, "'; the model has: ", joined(frame_names_));
+  return id;
+}
+
+AnchorSetId Model::anchor_set_id(const std::string& name) const {
+  const AnchorSetId id{index_of(anchor_set_names_, name)};
+  require(id.valid(), "unknown anchor set '", name, "'; the model has: ", joined(anchor_set_names_));
+  return id;
+}
+
 std::string Model::describe() const {
   std::ostringstream o;
   o << num_dofs_ << " DoFs in " << blocks_.size() << " blocks\n";
@@ -58,7 +88,7 @@ const Avatar& ModelBuilder::avatar(int body) const {
   return *specs_[body].avatar;
 }
 
-void ModelBuilder::add_term(std::shared_ptr<const EnergyTerm> term, std::vector<int> bodies) {
+int ModelBuilder::add_term(std::shared_ptr<const EnergyTerm> term, std::vector<int> bodies) {
   require(term != nullptr, "ModelBuilder::add_term: null term");
   require(!bodies.empty(), "ModelBuilder::add_term: term '", term->name(), "' is bound to no body");
   std::set<int> seen;
@@ -67,7 +97,31 @@ void ModelBuilder::add_term(std::shared_ptr<const EnergyTerm> term, std::vector<
             ", but the model has ", specs_.size(), " bodies");
     require(seen.insert(b).second, "ModelBuilder::add_term: term '", term->name(), "' names body ", b, " twice");
   }
+  std::vector<FrameId> frames;
+  for (const std::string& f : term->input_frames()) frames.push_back(add_frame(f));
+  const std::string anchors = term->input_anchor_set();
+  term_anchor_sets_.push_back(anchors.empty() ? AnchorSetId{} : add_anchor_set(anchors));
+  term_frames_.push_back(std::move(frames));
   terms_.emplace_back(std::move(term), std::move(bodies));
+  return int(terms_.size()) - 1;
+}
+
+FrameId ModelBuilder::add_frame(const std::string& name) {
+  int i = index_of(frame_names_, name);
+  if (i < 0) {
+    i = int(frame_names_.size());
+    frame_names_.push_back(name);
+  }
+  return FrameId{i};
+}
+
+AnchorSetId ModelBuilder::add_anchor_set(const std::string& name) {
+  int i = index_of(anchor_set_names_, name);
+  if (i < 0) {
+    i = int(anchor_set_names_.size());
+    anchor_set_names_.push_back(name);
+  }
+  return AnchorSetId{i};
 }
 
 std::shared_ptr<const Model> ModelBuilder::build() const {
@@ -77,6 +131,8 @@ std::shared_ptr<const Model> ModelBuilder::build() const {
   require(o.newton.iterations >= 1, "model: Newton iterations = ", o.newton.iterations, ", expected >= 1");
   auto m = std::make_shared<Model>();
   m->options_ = o;
+  m->frame_names_ = frame_names_;
+  m->anchor_set_names_ = anchor_set_names_;
   const int B = int(specs_.size());
 
   // Groups: connected components of bodies linked by terms (union–find).
@@ -132,10 +188,13 @@ std::shared_ptr<const Model> ModelBuilder::build() const {
   }
   m->num_dofs_ = offset;
 
-  for (const auto& [term, bodies] : terms_) {
+  for (size_t ti = 0; ti < terms_.size(); ++ti) {
+    const auto& [term, bodies] = terms_[ti];
     Model::BoundTerm t;
     t.term = term;
     t.bodies = bodies;
+    t.frames = term_frames_[ti];
+    t.anchor_set = term_anchor_sets_[ti];
     const BodyBlocks use = term->blocks();
     std::vector<std::pair<int, int>> ranges;
     int local = 0;

@@ -40,6 +40,25 @@ Vec3 pelvis_origin(const Model::Body& b, const Configuration& q) {
                                                        : Vec3(G.translation());
 }
 
+/// The step's world frames by id, translated by −c into the step frame
+/// (frames set by name resolved against the model's names).
+void gather_frames(const Model& m, const StepInputs& in, const Vec3& c, GroupWorkspace& ws) {
+  const size_t F = m.frame_names().size();
+  ws.frames.assign(F, WorldFrame{});
+  ws.frame_given.assign(F, 0);
+  for (size_t i = 0; i < F; ++i)
+    if (const WorldFrame* f = in.frames.find(FrameId{int(i)})) {
+      ws.frames[i] = *f;
+      ws.frame_given[i] = 1;
+    }
+  for (const auto& [name, f] : in.frames.by_name())
+    if (const FrameId id = m.find_frame(name); id.valid()) {
+      ws.frames[size_t(id.index)] = f;
+      ws.frame_given[size_t(id.index)] = 1;
+    }
+  for (WorldFrame& f : ws.frames) f.pose.translation() -= c;
+}
+
 /// One group's step (step.hpp): its own frame, its own Newton system.
 StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs, GroupWorkspace& ws) {
   const Model::Group& g = m.groups()[gi];
@@ -55,8 +74,7 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
     translate_bones(ws.targets[k].bones, -c);
     ws.targets[k].pose.translation -= c;
   }
-  ws.frames = inputs.frames;
-  for (auto& [name, f] : ws.frames) f.pose.translation() -= c;
+  gather_frames(m, inputs, c, ws);
   for (int b : g.bodies) {
     translate_bones(s.bodies[b].q.bones, -c);
     translate_bones(s.bodies[b].q_prev.bones, -c);
@@ -81,7 +99,11 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
     ctx.target_pose = ws.targets[slots[0]].pose;
     ctx.target_bones = ws.targets[slots[0]].bones;
     ctx.frame_origin = c;
-    ctx.frames = &ws.frames;
+    ctx.frames.clear();
+    for (FrameId f : t.frames)
+      ctx.frames.push_back(ws.frame_given[size_t(f.index)] ? &ws.frames[size_t(f.index)] : nullptr);
+    const size_t set = size_t(t.anchor_set.index);
+    ctx.anchors = t.anchor_set.valid() && set < inputs.anchors.size() ? &inputs.anchors[set] : nullptr;
     ctx.bound.clear();
     for (size_t j = 0; j < t.bodies.size(); ++j) {
       const int b = t.bodies[j];
@@ -106,8 +128,8 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
     for (BoundBody& bb : t.ctx->bound) bb.q = &q[bb.slot];
     const int b0 = t.ctx->bound[0].body;
     for (TermQuantity& v : t.term->report(*t.ctx, q[t.ctx->bound[0].slot]))
-      rep.quantities.push_back(
-          {t.term->name(), b0, v.name, v.unit, std::vector<double>(v.value.data(), v.value.data() + v.value.size())});
+      rep.quantities.push_back({t.term->name(), b0, v.name, v.unit,
+                                std::vector<double>(v.value.data(), v.value.data() + v.value.size()), g.terms[k]});
   }
   for (size_t k = 0; k < g.bodies.size(); ++k) {
     const int b = g.bodies[k];
@@ -121,7 +143,8 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
   }
   // The contexts point into this step's locals: drop the pointers.
   for (StepContext& ctx : ws.contexts) {
-    ctx.frames = nullptr;
+    ctx.frames.clear();
+    ctx.anchors = nullptr;
     ctx.bound.clear();
   }
   return rep;

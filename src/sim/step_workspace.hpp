@@ -3,7 +3,6 @@
 // caches, per-term contexts, shifted inputs, the Newton system). Recreated
 // when the model changes. Groups have disjoint scratch, so they can be
 // stepped concurrently.
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,7 +17,8 @@ struct GroupWorkspace {
   std::vector<std::unique_ptr<TermCache>> caches;  ///< one per group term (null: none)
   std::vector<StepContext> contexts;               ///< one per group term, rebuilt each step
   std::vector<BodyTargets> targets;                ///< per group body, in the step frame
-  std::map<std::string, WorldFrame> frames;        ///< in the step frame
+  std::vector<WorldFrame> frames;                   ///< by FrameId, in the step frame
+  std::vector<char> frame_given;                   ///< by FrameId: given this step
   StepSystem system;
 };
 

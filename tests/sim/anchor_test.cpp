@@ -53,7 +53,7 @@ struct Rig {
   const Avatar* avatar = nullptr;
   std::vector<DofLayout> layouts;
   std::vector<Configuration> q, q_prev, q_prev2;
-  std::map<std::string, WorldFrame> frames;
+  std::vector<AnchorPoint> anchors;  ///< the anchor term's set for the step
 
   int size() const { return layouts.back().end(); }
   StepContext context() const {
@@ -63,7 +63,7 @@ struct Rig {
     ctx.h = kStep;
     ctx.q_prev = q_prev[0];
     ctx.q_prev2 = q_prev2[0];
-    ctx.frames = &frames;
+    ctx.anchors = &anchors;
     for (size_t i = 0; i < layouts.size(); ++i)
       ctx.bound.push_back({int(i), int(i), i == 0 ? avatar : nullptr, layouts[i], &q[i], &q_prev[i], &q_prev2[i]});
     return ctx;
@@ -189,7 +189,7 @@ TEST(AnchorTerm, KinematicToolMatchesClosedFormAndFiniteDifferences) {
     jaw.angular_velocity = Vec3(0.4, -1.0, 0.3);
     jaw.linear_velocity = Vec3(0.05, 0.2, -0.1);
     const std::vector<Anchor> anchors = make_anchors(term.points(), rig.q_prev[0], jaw.pose, rng);
-    add_anchor_frames("jaw", jaw, anchors, false, rig.frames);
+    anchor_points(jaw, anchors, false, rig.anchors);
     // Tool points by hand: a = T o; at t, carried back by the frame's twist.
     std::vector<Vec3> a_next, a_t;
     for (const Anchor& an : anchors) {
@@ -217,7 +217,7 @@ TEST(AnchorTerm, DynamicToolGetsTheOppositeForceAndMatchesFiniteDifferences) {
     const std::vector<Anchor> anchors = make_anchors(term.points(), rig.q_prev[0], G_t, rng);
     WorldFrame body_t;
     body_t.pose = G_t;
-    add_anchor_frames("gripper", body_t, anchors, true, rig.frames);
+    anchor_points(body_t, anchors, true, rig.anchors);
     std::vector<Vec3> a_t;
     for (const Anchor& an : anchors) a_t.push_back(G_t * an.offset);
     const Check ch = check_term(
@@ -256,8 +256,7 @@ TEST(AnchorTerm, ReportsPerAnchorForcesAndIsInactiveWithoutAnchors) {
   WorldFrame jaw;
   jaw.pose.translation() = Vec3(0.01, 0.02, 0.03);
   const Vec3 x3 = term.points().world_point(3, rig.q[0]);
-  add_anchor_frames("jaw", jaw, {{3, jaw.pose.inverse() * (x3 + Vec3(0, 0.002, 0))}}, false, rig.frames);
-  rig.frames["jaw/anchorage"] = WorldFrame{};  // another frame whose name only starts alike: ignored
+  anchor_points(jaw, {{3, jaw.pose.inverse() * (x3 + Vec3(0, 0.002, 0))}}, false, rig.anchors);
   ctx = rig.context();
   cache = begin_term_step(term, ctx);
   ASSERT_TRUE(term.active(ctx));
@@ -266,9 +265,15 @@ TEST(AnchorTerm, ReportsPerAnchorForcesAndIsInactiveWithoutAnchors) {
   EXPECT_LT((quantity(rep, "anchor_forces") - Vec3(0, k * 0.002, 0)).norm(), 1e-9);
   EXPECT_NEAR(quantity(rep, "max_stretch")[0], 0.002, 1e-12);
   // Re-arming replaces the previous anchors; a bad point index is one clear error.
-  add_anchor_frames("jaw", jaw, {}, false, rig.frames);
-  EXPECT_EQ(rig.frames.count(anchor_frame_name("jaw", 3)), 0u);
-  rig.frames[anchor_frame_name("jaw", 100000)] = WorldFrame{};
+  anchor_points(jaw, {}, false, rig.anchors);
+  EXPECT_TRUE(rig.anchors.empty());
+  ctx = rig.context();
+  cache = begin_term_step(term, ctx);
+  EXPECT_FALSE(term.active(ctx));
+  rig.anchors = {AnchorPoint{100000, Vec3::Zero(), Vec3::Zero()}};
+  ctx = rig.context();
+  EXPECT_THROW(begin_term_step(term, ctx), Error);
+  rig.anchors = {AnchorPoint{-1, Vec3::Zero(), Vec3::Zero()}};
   ctx = rig.context();
   EXPECT_THROW(begin_term_step(term, ctx), Error);
   EXPECT_THROW(AnchorTerm("jaw", PosedPoints::at_surface(a), false, {0.0, 1.0}), Error);
@@ -288,9 +293,9 @@ TEST(AnchorTerm, MaxStretchIsTheLargestAnchorsNotTheLastOnes) {
   WorldFrame jaw;
   jaw.pose.translation() = Vec3(0.01, 0.02, 0.03);
   const Vec3 x3 = term.points().world_point(3, rig.q[0]), x5 = term.points().world_point(5, rig.q[0]);
-  add_anchor_frames("jaw", jaw,
-                    {{3, jaw.pose.inverse() * (x3 + Vec3(0, 0.003, 0))}, {5, jaw.pose.inverse() * (x5 + Vec3(0.001, 0, 0))}},
-                    false, rig.frames);
+  anchor_points(jaw,
+                {{3, jaw.pose.inverse() * (x3 + Vec3(0, 0.003, 0))}, {5, jaw.pose.inverse() * (x5 + Vec3(0.001, 0, 0))}},
+                false, rig.anchors);
   StepContext ctx = rig.context();
   auto cache = begin_term_step(term, ctx);
   const std::vector<TermQuantity> rep = term.report(ctx, rig.q[0]);

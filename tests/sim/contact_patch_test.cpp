@@ -48,7 +48,9 @@ StepContext context(const Avatar& a, const std::map<std::string, WorldFrame>* fr
   ctx.q_prev.bones = identity_bones();
   ctx.q_prev.z = VecX::Zero(a.num_reduced());
   ctx.q_prev2 = ctx.q_prev;
-  ctx.frames = frames;
+  // The term's one input frame: the only one these tests give.
+  if (frames)
+    for (const auto& [name, f] : *frames) ctx.frames.push_back(&f);
   return ctx;
 }
 

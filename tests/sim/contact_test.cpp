@@ -92,7 +92,9 @@ StepContext bind_bodies(std::vector<Bound>& bodies, const std::map<std::string, 
   ctx.h = kH;
   ctx.q_prev = bodies[0].q_prev;
   ctx.q_prev2 = bodies[0].q_prev2;
-  ctx.frames = frames;
+  // The term's one input frame: the only one these tests give.
+  if (frames)
+    for (const auto& [name, f] : *frames) ctx.frames.push_back(&f);
   for (size_t i = 0; i < bodies.size(); ++i)
     ctx.bound.push_back({int(i), int(i), bodies[i].avatar, bodies[i].layout, &bodies[i].q, &bodies[i].q_prev,
                          &bodies[i].q_prev2});
@@ -355,8 +357,7 @@ TEST(SdfContact, BroadPhaseKeepsEveryPenetratingSampleAndNothingFar) {
   cache = begin_term_step(term, ctx);
   EXPECT_FALSE(term.active(ctx));
   // A missing frame is named.
-  std::map<std::string, WorldFrame> none;
-  ctx.frames = &none;
+  ctx.frames.clear();
   EXPECT_THROW(begin_term_step(term, ctx), Error);
 }
 

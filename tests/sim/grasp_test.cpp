@@ -72,7 +72,7 @@ Isometry jaw_pose(double lift) {
   return T;
 }
 
-/// One step: the controller senses on the current skin, the anchors travel as frames.
+/// One step: the controller senses on the current skin, the anchors travel in the step inputs.
 StepReport grasp_step(Simulator& sim, GraspController& grasp, const PosedPoints& skin, double lift, double lift_speed,
                       double closure) {
   const Avatar& a = sim.avatar();
@@ -85,7 +85,8 @@ StepReport grasp_step(Simulator& sim, GraspController& grasp, const PosedPoints&
   in.bodies.resize(1);
   in.bodies[0].bones = identity_bones();
   in.frames["jaw"] = jaw;
-  add_anchor_frames("jaw", jaw, grasp.anchors(), false, in.frames);
+  in.anchors.resize(sim.model().anchor_set_names().size());
+  anchor_points(jaw, grasp.anchors(), false, in.anchors[size_t(sim.model().anchor_set_id("jaw").index)]);
   return sim.step(in);
 }
 
@@ -237,7 +238,9 @@ TEST(Grasp, ADynamicToolPullingAFreeBodyConservesMomentum) {
     StepInputs in;
     in.bodies.resize(2);
     in.bodies[body].bones = identity_bones();  // unused by dynamic bones without tracking
-    add_anchor_frames("tool", WorldFrame{sim.state(tool).bones[0]}, grasp.anchors(), true, in.frames);
+    in.anchors.resize(sim.model().anchor_set_names().size());
+    anchor_points(WorldFrame{sim.state(tool).bones[0]}, grasp.anchors(), true,
+                  in.anchors[size_t(sim.model().anchor_set_id("tool").index)]);
     const StepReport rep = sim.step(in);
     // Iterations run to round-off: a last one may find no decrease (rejected, q kept); the first must not.
     EXPECT_GT(rep.accepted + rep.damped, 0) << "step " << i;

@@ -68,7 +68,7 @@ class RandomQuadraticTerm : public EnergyTerm {
   VecX b_;
 };
 
-/// ½ k |p − f|², p = the pelvis of the bound body, f = the named world frame's
+/// ½ k |p − f|², p = the pelvis of the bound body, f = its input frame's
 /// origin: pulls the body towards a world-fixed anchor. Inactive when the
 /// frame is not among the step's inputs; reports the spring force on the body.
 class AnchorSpringTerm : public EnergyTerm {
@@ -76,10 +76,11 @@ class AnchorSpringTerm : public EnergyTerm {
   AnchorSpringTerm(std::string frame, double k) : frame_(std::move(frame)), k_(k) {}
   std::string name() const override { return "anchor_spring"; }
   BodyBlocks blocks() const override { return BodyBlocks::Bones; }
-  bool active(const StepContext& ctx) const override { return ctx.frames && ctx.frames->count(frame_); }
+  std::vector<std::string> input_frames() const override { return {frame_}; }
+  bool active(const StepContext& ctx) const override { return ctx.frame() != nullptr; }
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override {
     const Vec3 p = q.bones[0] * Vec3(ctx.avatar->joints_rest.row(0).transpose());
-    const Vec3 r = p - ctx.frames->at(frame_).pose.translation();
+    const Vec3 r = p - ctx.frame()->pose.translation();
     const Mat36 J = point_jacobian(p);
     if (grad) grad->segment<6>(ctx.layout.bone_offset(0)) += k_ * J.transpose() * r;
     if (hess) hess->block<6, 6>(ctx.layout.bone_offset(0), ctx.layout.bone_offset(0)) += k_ * J.transpose() * J;
@@ -87,7 +88,7 @@ class AnchorSpringTerm : public EnergyTerm {
   }
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override {
     const Vec3 p = q.bones[0] * Vec3(ctx.avatar->joints_rest.row(0).transpose());
-    const Vec3 f = -k_ * (p - ctx.frames->at(frame_).pose.translation());
+    const Vec3 f = -k_ * (p - ctx.frame()->pose.translation());
     return {{"force", "N", f}};
   }
 
@@ -406,13 +407,14 @@ TEST(Model, AWorldFixedAnchorStaysWhereTheSceneHasIt) {
   const Vec3 anchor(3.0, 1.5, -2.0);
   StepInputs in;
   in.bodies = {{sim.state().bones, {}}};
-  in.frames["anchor"].pose.translation() = anchor;
+  const FrameId anchor_frame = sim.model().frame_id("anchor");
+  in.frames[anchor_frame].pose.translation() = anchor;
   StepReport rep;
   // Nothing damps the swing but backward Euler itself (the flesh rings for a
   // few seconds after the 4 m pull): 20 s lets it settle well below 1 N.
   for (int i = 0; i < 1200; ++i) rep = sim.step(in);
   EXPECT_LT((sim.joints().row(0).transpose() - anchor).norm(), 1e-3);
-  EXPECT_EQ(in.frames.at("anchor").pose.translation(), anchor);
+  EXPECT_EQ(in.frames.find(anchor_frame)->pose.translation(), anchor);
   // The report hook: the spring's force on the body, ~0 at rest.
   ASSERT_EQ(rep.quantities.size(), 1u);
   EXPECT_EQ(rep.quantities[0].term, "anchor_spring");

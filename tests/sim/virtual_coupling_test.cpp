@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <map>
+#include <optional>
 #include <random>
 
 #include <Eigen/Eigenvalues>
@@ -26,7 +26,7 @@ constexpr double kH = 1.0 / 500.0;
 struct Rig {
   DofLayout layout;
   Configuration q, q_prev;
-  std::map<std::string, WorldFrame> frames;
+  std::optional<WorldFrame> device;  ///< the term's input frame (device_frame_name)
   std::unique_ptr<TermCache> cache;
 
   StepContext context() const {
@@ -35,7 +35,7 @@ struct Rig {
     ctx.h = kH;
     ctx.q_prev = q_prev;
     ctx.q_prev2 = q_prev;
-    ctx.frames = &frames;
+    ctx.frames = {device ? &*device : nullptr};
     ctx.cache = cache.get();
     return ctx;
   }
@@ -57,7 +57,7 @@ Rig make_rig(const VirtualCouplingTerm& term, const Isometry& tool, const Isomet
   r.q.z = VecX(0);
   r.q_prev.bones = {tool_prev};
   r.q_prev.z = VecX(0);
-  r.frames[device_frame_name("probe")] = device;
+  r.device = device;
   r.cache = term.make_cache();
   term.begin_step(r.context());
   return r;
@@ -141,7 +141,7 @@ TEST(VirtualCoupling, RejectsBadOptionsAndAMissingDeviceFrame) {
   test::expect_error([] { VirtualCouplingTerm("probe", VirtualCouplingOptions{1, -1, 1, 1}); }, {"probe", "damping"});
   VirtualCouplingTerm term("probe", VirtualCouplingOptions{});
   Rig r = make_rig(term, Isometry::Identity(), Isometry::Identity(), WorldFrame{});
-  r.frames.clear();
+  r.device.reset();
   test::expect_error([&] { term.begin_step(r.context()); }, {"coupling:probe", "probe/device"});
 }
 

@@ -63,6 +63,7 @@ struct CompiledObject {
   const RigidObjectDescription* desc = nullptr;
   RigidObjectModel model;
   int model_index = -1;  ///< dynamic objects: their body in the model
+  FrameId frame;         ///< static and kinematic objects: their world frame in the step inputs
 };
 
 /// A gripper jaw: a contact shape turning about the tool's hinge with the closure.
@@ -71,9 +72,13 @@ struct CompiledJaw {
   RigidObjectModel model;
   Isometry offset = Isometry::Identity();  ///< the jaw frame in the tool frame at closure 0
   double side = 1;                         ///< +1 or −1: which way it turns
+  /// Its world frame in the step inputs: the jaw's pose (kinematic tool) or
+  /// its moving shape's on the coupled body (moving_shape_frame_name).
+  FrameId frame;
 };
 
-/// A tool of the scene: its shapes, coupling and grasp settings, and its terms' keys.
+/// A tool of the scene: its shapes, coupling and grasp settings, its inputs'
+/// ids and the model terms that act on it.
 struct CompiledTool {
   const ToolDescription* desc = nullptr;
   RigidObjectModel shape;                ///< when desc->has_shape
@@ -81,9 +86,14 @@ struct CompiledTool {
   int model_index = -1;                  ///< coupled tools: their rigid body in the model
   VirtualCouplingOptions coupling;       ///< coupled tools: the coupling's gains
   GraspOptions grasp;                    ///< tools with sensors: the grasp controller's settings
-  std::vector<std::string> anchor_keys;  ///< tools with sensors, per body: its anchor term's tool name
-  std::string contact_term;              ///< "contact:<tool>": its contact terms' name
-  std::string anchor_prefix;             ///< "anchor:<tool>@": its anchor terms' names start so
+  /// Its world frame in the step inputs: the tool's pose (kinematic) or its
+  /// device's (coupled: device_frame_name).
+  FrameId frame;
+  std::vector<AnchorSetId> anchor_sets;  ///< tools with sensors, per body: its anchor term's set
+  /// Model term indices: its contact terms (shape and jaws, every body) and
+  /// anchor terms, whose forces on the bodies the tool feels (ToolDriver::feel).
+  std::vector<int> contact_terms, anchor_terms;
+  int coupling_term = -1;                ///< coupled tools: the model index of its coupling
 
   bool coupled() const { return model_index >= 0; }
   /// A jaw's pose in the tool frame at `closure` (rad): turned by side·closure/2 about the hinge.

@@ -3,8 +3,9 @@
 // (scene_description.hpp) becomes a Model — bodies with their soft-tissue and
 // skeleton terms, dynamic rigid objects as 6-DoF bodies, tools, and only the
 // contact terms the scene's pairs need — and a State, stepped with StepInputs
-// that carry each body's motion targets and the static and kinematic objects
-// and tools as named world frames.
+// that carry each body's motion targets, the static and kinematic objects and
+// tools as world frames and the tools' grasps as anchored points (by the ids
+// the compiler registered).
 //
 // The session is a facade: compile_scene (scene_compiler.hpp) makes the Model,
 // the initial State and the bodies', objects' and tools' constant parts; one
@@ -133,6 +134,8 @@ class SceneSession {
   /// Index of the tool named `name`; throws naming the known tools otherwise.
   int tool_index(const std::string& name) const;
   const SceneToolState& tool_state(int tool) const;
+  /// The tool as compiled: its input ids and the model terms acting on it.
+  const CompiledTool& compiled_tool(int tool) const;
   /// Pushes a device pose (world; closure rad) for the next steps: the tool
   /// follows pushed poses from now on (its keyframes/file are no longer read).
   /// Throws on a non-finite pose or a zero quaternion.

@@ -18,13 +18,13 @@
 // shared across threads and runs). Anything a term computes per step (e.g. the
 // inertia's explicit prediction x*) lives in its TermCache, which the State
 // owns: make_cache() creates it, begin_step() fills it, compute() reads it.
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/core/body_pose.hpp"
+#include "sflsh/sim/anchor_point.hpp"
 #include "sflsh/sim/configuration.hpp"
 
 namespace sflsh {
@@ -41,7 +41,7 @@ enum class BodyBlocks {
   BonesAndSoft  ///< both (terms on embedded points: inertia, gravity, contact)
 };
 
-/// A named world frame given as a step input (an obstacle's or a tool's pose):
+/// A world frame given as a step input (an obstacle's or a tool's pose):
 /// pose at t + h and its twist (ω, v), world frame, rad/s and m/s.
 struct WorldFrame {
   Isometry pose = Isometry::Identity();
@@ -69,8 +69,8 @@ struct BoundBody {
 /// (avatar, layout, q_prev, q_prev2, targets) describe the term's first bound
 /// body; `bound` lists every bound body.
 ///
-/// Frame: every world-space quantity here (q, targets, frames) is expressed in
-/// the step frame, the world translated by −frame_origin (the integrator
+/// Frame: every world-space quantity here (q, targets, frames; not anchors) is
+/// expressed in the step frame, the world translated by −frame_origin (the integrator
 /// centres each step on the first body's pelvis: one Newton step of a
 /// translation-invariant problem then does not depend on the distance to the
 /// world origin). world = step frame + frame_origin.
@@ -86,10 +86,18 @@ struct StepContext {
   BodyPose target_pose;
   std::vector<Isometry> target_bones;
   Vec3 frame_origin = Vec3::Zero();  ///< world position of the step frame's origin (m)
-  /// Named world frames at t + h (obstacles, tools), in the step frame; may be null.
-  const std::map<std::string, WorldFrame>* frames = nullptr;
+  /// The world frames the term reads (EnergyTerm::input_frames(), in that
+  /// order) at t + h, in the step frame; null: not given this step.
+  std::vector<const WorldFrame*> frames;
+  /// The term's anchored points (EnergyTerm::input_anchor_set()) as the step
+  /// inputs give them: positions in the world (the term subtracts
+  /// frame_origin); null: none given this step.
+  const std::vector<AnchorPoint>* anchors = nullptr;
   std::vector<BoundBody> bound;      ///< every bound body (bound[0] = the fields above)
   TermCache* cache = nullptr;        ///< the term's own cache in the State (null if it has none)
+
+  /// The i-th of the term's input frames, or null when it is not given.
+  const WorldFrame* frame(size_t i = 0) const { return i < frames.size() ? frames[i] : nullptr; }
 };
 
 /// A typed quantity a term reports after a step (e.g. a reaction force).
@@ -106,6 +114,13 @@ class EnergyTerm {
   virtual std::string name() const = 0;
   /// The blocks of each bound body this term touches (default: bones and soft).
   virtual BodyBlocks blocks() const { return BodyBlocks::BonesAndSoft; }
+  /// The world frames the term reads each step, by name (default: none). The
+  /// ModelBuilder registers them (add_frame) and the step hands the term
+  /// their values in this order (StepContext::frames).
+  virtual std::vector<std::string> input_frames() const { return {}; }
+  /// The set of anchored points the term reads each step, by name ("" = none,
+  /// the default); registered like input_frames() (StepContext::anchors).
+  virtual std::string input_anchor_set() const { return ""; }
   /// A fresh per-step cache for this term, or null when it needs none.
   virtual std::unique_ptr<TermCache> make_cache() const { return nullptr; }
   /// Called once per time step before the Newton iterations (e.g. to compute

@@ -27,6 +27,7 @@
 #include "sflsh/asset/avatar.hpp"
 #include "sflsh/sim/configuration.hpp"
 #include "sflsh/sim/energy_term.hpp"
+#include "sflsh/sim/input_ids.hpp"
 #include "sflsh/sim/newton_step.hpp"
 
 namespace sflsh {
@@ -46,7 +47,7 @@ struct DofBlock {
 /// centre of mass, to the world; 6 DoFs turning about the centre of mass, no
 /// soft block. Its mass enters through the terms the scene adds
 /// (rigid_body_terms.hpp); kinematic and static objects are not bodies but
-/// named world frames (StepInputs::frames).
+/// world frames of the step inputs (ModelBuilder::add_frame, StepInputs::frames).
 struct BodySpec {
   std::string name;                        ///< unique within the model (e.g. "avatar", "alice", "ball")
   std::shared_ptr<const Avatar> avatar;    ///< its asset (shared, immutable); null: a rigid object
@@ -80,6 +81,8 @@ class Model {
     std::vector<int> bodies;                 ///< bound bodies (≥ 1)
     std::vector<DofLayout> local_layouts;    ///< per bound body, in the term's local system
     TermPlacement placement;                 ///< where the local system sits in the global one
+    std::vector<FrameId> frames;             ///< its input frames (EnergyTerm::input_frames order)
+    AnchorSetId anchor_set;                  ///< its anchored points (invalid: it reads none)
   };
 
   /// Bodies coupled by terms, solved together (see header comment). Layouts
@@ -102,6 +105,16 @@ class Model {
   int num_dofs() const { return num_dofs_; }
   /// Index of the body called `name`; throws naming the known bodies.
   int body_index(const std::string& name) const;
+  /// Names of the step inputs' world frames, by FrameId::index.
+  const std::vector<std::string>& frame_names() const { return frame_names_; }
+  /// The world frame called `name`; throws naming the known frames.
+  FrameId frame_id(const std::string& name) const;
+  /// The world frame called `name`, or an invalid id.
+  FrameId find_frame(const std::string& name) const;
+  /// Names of the anchor sets, by AnchorSetId::index.
+  const std::vector<std::string>& anchor_set_names() const { return anchor_set_names_; }
+  /// The anchor set called `name`; throws naming the known sets.
+  AnchorSetId anchor_set_id(const std::string& name) const;
   /// The first term of type T bound to `body` (e.g. the ElasticTerm for
   /// diagnostics), or null.
   template <class T>
@@ -120,6 +133,7 @@ class Model {
   std::vector<BoundTerm> terms_;
   std::vector<Group> groups_;
   std::vector<DofBlock> blocks_;
+  std::vector<std::string> frame_names_, anchor_set_names_;
   ModelOptions options_;
   int num_dofs_ = 0;
 };
@@ -134,10 +148,20 @@ class ModelBuilder {
   /// rigid object turns about its centre of mass (its frame's origin).
   int add_body(BodySpec spec);
   /// Binds `term` to `bodies` (indices from add_body; the first is the one its
-  /// single-body fields describe). The term declares which blocks of each it touches.
-  void add_term(std::shared_ptr<const EnergyTerm> term, std::vector<int> bodies);
+  /// single-body fields describe). The term declares which blocks of each it
+  /// touches. Returns its index in the model (Model::terms()).
+  int add_term(std::shared_ptr<const EnergyTerm> term, std::vector<int> bodies);
   /// Convenience: a term on one body.
-  void add_term(EnergyTermPtr term, int body) { add_term(std::shared_ptr<const EnergyTerm>(std::move(term)), {body}); }
+  int add_term(EnergyTermPtr term, int body) {
+    return add_term(std::shared_ptr<const EnergyTerm>(std::move(term)), {body});
+  }
+  /// The world frame called `name` of the step inputs (StepInputs::frames):
+  /// a new id, or the frame's id when it is already registered. add_term
+  /// registers the frames its term reads (EnergyTerm::input_frames).
+  FrameId add_frame(const std::string& name);
+  /// The anchor set called `name` (StepInputs::anchors), new or already
+  /// registered; add_term registers its term's (EnergyTerm::input_anchor_set).
+  AnchorSetId add_anchor_set(const std::string& name);
   ModelOptions& options() { return options_; }
   const Avatar& avatar(int body) const;
   int num_bodies() const { return int(specs_.size()); }
@@ -148,6 +172,9 @@ class ModelBuilder {
   ModelOptions options_;
   std::vector<BodySpec> specs_;
   std::vector<std::pair<std::shared_ptr<const EnergyTerm>, std::vector<int>>> terms_;
+  std::vector<std::vector<FrameId>> term_frames_;  ///< per term: its input frames
+  std::vector<AnchorSetId> term_anchor_sets_;      ///< per term: its anchor set
+  std::vector<std::string> frame_names_, anchor_set_names_;
 };
 
 }  // namespace sflsh

@@ -1,17 +1,18 @@
 #pragma once
 // The mutable half of the runtime (MuJoCo's mjData role): per body q_t and
 // q_{t−1}, the time, and the per-step caches of the model's terms; plus the
-// per-step inputs (motion targets per body, named world frames of obstacles
-// and tools). A step is a function of (Model, State, StepInputs) (step.hpp).
+// per-step inputs (motion targets per body, obstacles' and tools' world frames,
+// grasps' anchored points; by input id). A step is a function of (Model, State, StepInputs) (step.hpp).
 // A State can be copied (the copy gets fresh caches: they are recomputed at
 // the start of every step) and saved/restored (state_file.hpp).
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "sflsh/sim/anchor_point.hpp"
 #include "sflsh/sim/energy_term.hpp"
 #include "sflsh/sim/model.hpp"
+#include "sflsh/sim/world_frame_inputs.hpp"
 
 namespace sflsh {
 
@@ -30,8 +31,11 @@ struct BodyTargets {
 
 /// Inputs of one step.
 struct StepInputs {
-  std::vector<BodyTargets> bodies;            ///< one per model body
-  std::map<std::string, WorldFrame> frames;   ///< named world frames at t + h (world, not shifted)
+  std::vector<BodyTargets> bodies;  ///< one per model body
+  WorldFrameInputs frames;          ///< world frames at t + h (world, not shifted), by FrameId
+  /// Anchored points per anchor set (by AnchorSetId; world, not shifted). A
+  /// set not given, or empty, holds nothing this step.
+  std::vector<std::vector<AnchorPoint>> anchors;
 };
 
 /// Scratch of a step: the terms' caches and contexts (see header comment).

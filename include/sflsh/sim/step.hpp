@@ -8,7 +8,8 @@
 // time t (physics is translation invariant; one Newton step is not, since
 // bones turn about points whose distance to the origin enters the
 // linearization). Every world-space input — each body's q_t, q_{t−1}, targets
-// and every named world frame — is translated by the same −c, and the result
+// and every world frame and anchored point — is translated by the same −c
+// (anchor terms shift their points themselves), and the result
 // translated back, so a world-fixed obstacle or tool frame stays where the
 // scene put it. StepReport energies are those of the centred frame (gravity's
 // energy differs by the constant M g·c).

@@ -30,6 +30,7 @@ struct TermQuantityReport {
   int body = 0;       ///< its first bound body
   std::string name, unit;
   std::vector<double> value;
+  int term_index = -1;  ///< the term's index in the Model (Model::terms())
 };
 
 struct StepReport {

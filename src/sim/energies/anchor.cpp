@@ -1,5 +1,6 @@
 #include "sflsh/sim/energies/anchor.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sflsh/core/error.hpp"
@@ -13,6 +14,7 @@ struct AnchorCache : TermCache {
   /// Kinematic tool: a_p at t + h; dynamic tool: the offset o_p in the tool's body frame.
   std::vector<Vec3> target;
   std::vector<Vec3> a_t, x_t;  // tool and flesh points at time t (step frame)
+  std::vector<int> order;      // the step's anchors (indices into ctx.anchors) by increasing point
 };
 
 const AnchorCache& anchor_cache(const StepContext& ctx, const std::string& name) {
@@ -20,24 +22,18 @@ const AnchorCache& anchor_cache(const StepContext& ctx, const std::string& name)
   return static_cast<const AnchorCache&>(*ctx.cache);
 }
 
-std::string anchor_prefix(const std::string& tool) { return tool + "/anchor/"; }
-
 }  // namespace
 
-std::string anchor_frame_name(const std::string& tool, int point) { return anchor_prefix(tool) + std::to_string(point); }
-
-void add_anchor_frames(const std::string& tool, const WorldFrame& tool_frame, const std::vector<Anchor>& anchors,
-                       bool dynamic_tool, std::map<std::string, WorldFrame>& frames) {
-  const std::string prefix = anchor_prefix(tool);
-  for (auto it = frames.lower_bound(prefix); it != frames.end() && it->first.compare(0, prefix.size(), prefix) == 0;)
-    it = frames.erase(it);
+void anchor_points(const WorldFrame& tool_frame, const std::vector<Anchor>& anchors, bool dynamic_tool,
+                   std::vector<AnchorPoint>& points) {
+  points.clear();
   const Vec3 o = tool_frame.pose.translation();
   for (const Anchor& a : anchors) {
-    WorldFrame f;
-    f.pose.translation() = tool_frame.pose * a.offset;
-    if (!dynamic_tool)
-      f.linear_velocity = tool_frame.linear_velocity + tool_frame.angular_velocity.cross(f.pose.translation() - o);
-    frames[anchor_frame_name(tool, a.point)] = f;
+    AnchorPoint p;
+    p.point = a.point;
+    p.position = tool_frame.pose * a.offset;
+    if (!dynamic_tool) p.velocity = tool_frame.linear_velocity + tool_frame.angular_velocity.cross(p.position - o);
+    points.push_back(p);
   }
 }
 
@@ -56,28 +52,30 @@ void AnchorTerm::begin_step(const StepContext& ctx) const {
   AnchorCache& c = static_cast<AnchorCache&>(*ctx.cache);
   c.points.clear(), c.target.clear(), c.a_t.clear(), c.x_t.clear();
   if (dynamic_) require(ctx.bound.size() == 2, name(), ": a dynamic tool's anchors are bound to the body and the tool");
-  if (!ctx.frames) return;
+  if (!ctx.anchors) return;
   const Configuration& qt = ctx.bound.empty() ? ctx.q_prev : *ctx.bound[0].q_prev;
-  const std::string prefix = anchor_prefix(tool_);
-  for (auto it = ctx.frames->lower_bound(prefix);
-       it != ctx.frames->end() && it->first.compare(0, prefix.size(), prefix) == 0; ++it) {
-    const std::string digits = it->first.substr(prefix.size());
-    require(!digits.empty() && digits.size() < 10 && digits.find_first_not_of("0123456789") == std::string::npos,
-            name(), ": world frame '", it->first, "': expected '", prefix, "<point index>'");
-    const int p = std::stoi(digits);
-    require(p < points_.size(), name(), ": world frame '", it->first, "': point ", p, " out of range (", points_.size(),
+  // By increasing point, one anchor per point (the last given): the sums over
+  // anchors do not depend on the order the tool lists them in.
+  const std::vector<AnchorPoint>& given = *ctx.anchors;
+  c.order.resize(given.size());
+  for (size_t i = 0; i < given.size(); ++i) c.order[i] = int(i);
+  std::stable_sort(c.order.begin(), c.order.end(), [&](int i, int j) { return given[i].point < given[j].point; });
+  for (size_t k = 0; k < c.order.size(); ++k) {
+    const AnchorPoint& a = given[size_t(c.order[k])];
+    if (k + 1 < c.order.size() && given[size_t(c.order[k + 1])].point == a.point) continue;
+    const int p = a.point;
+    require(p >= 0 && p < points_.size(), name(), ": anchored point ", p, " out of range (", points_.size(),
             " points)");
-    const WorldFrame& f = it->second;
-    require(f.pose.translation().allFinite() && f.linear_velocity.allFinite(), name(), ": world frame '", it->first,
-            "' is not finite");
+    require(a.position.allFinite() && a.velocity.allFinite(), name(), ": anchored point ", p, " is not finite");
+    const Vec3 position = a.position - ctx.frame_origin;  // the step frame
     c.points.push_back(p);
     c.x_t.push_back(points_.world_point(p, qt));
     if (dynamic_) {
-      c.a_t.push_back(f.pose.translation());
-      c.target.push_back(ctx.bound[1].q_prev->bones[0].inverse() * f.pose.translation());
+      c.a_t.push_back(position);
+      c.target.push_back(ctx.bound[1].q_prev->bones[0].inverse() * position);
     } else {
-      c.target.push_back(f.pose.translation());
-      c.a_t.push_back(f.pose.translation() - ctx.h * f.linear_velocity);
+      c.target.push_back(position);
+      c.a_t.push_back(position - ctx.h * a.velocity);
     }
   }
 }

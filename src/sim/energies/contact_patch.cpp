@@ -201,10 +201,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
       object_motion = 2 * ((G.translation() - Gp.translation()).norm() + angle * extent);
     }
   } else {
-    require(ctx.frames != nullptr, name(), ": the step has no world frames");
-    const auto fr = ctx.frames->find(object_);
-    require(fr != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
-    const WorldFrame& f = fr->second;
+    require(ctx.frame() != nullptr, name(), ": the step inputs have no world frame '", object_, "'");
+    const WorldFrame& f = *ctx.frame();
     require(f.pose.matrix().allFinite(), name(), ": world frame '", object_, "' is not finite");
     c.field_pose = f.pose * shape_in_frame_;
     object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);

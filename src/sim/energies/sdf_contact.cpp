@@ -93,6 +93,10 @@ Isometry SdfContactTerm::field_pose(const StepContext& ctx) const {
 
 std::string moving_shape_frame_name(const std::string& object) { return object + "/shape"; }
 
+std::vector<std::string> SdfContactTerm::input_frames() const {
+  return {dynamic_ ? moving_shape_frame_name(object_) : object_};
+}
+
 void SdfContactTerm::begin_step(const StepContext& ctx) const {
   ContactCache& c = contact_cache(ctx, name());
   c.candidates.clear();
@@ -106,14 +110,12 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
     require(ctx.bound.size() == 2, name(), ": a dynamic object's contact is bound to the body and the object");
     const Isometry& G = ctx.bound[1].q_prev->bones[0];
     c.shape_in_frame = shape_in_frame_;
-    if (ctx.frames) {
+    if (const WorldFrame* f = ctx.frame()) {
       // A shape that moves on its body (a gripper's jaw): its pose for this
       // step, given in the world relative to the body's pose at t.
-      const auto it = ctx.frames->find(moving_shape_frame_name(object_));
-      if (it != ctx.frames->end()) {
-        require(it->second.pose.matrix().allFinite(), name(), ": world frame '", it->first, "' is not finite");
-        c.shape_in_frame = G.inverse() * it->second.pose;
-      }
+      require(f->pose.matrix().allFinite(), name(), ": world frame '", moving_shape_frame_name(object_),
+              "' is not finite");
+      c.shape_in_frame = G.inverse() * f->pose;
     }
     T = G * c.shape_in_frame;
     if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
@@ -122,10 +124,8 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
                            rotation_angle(G.linear() * Gp.linear().transpose()) * extent);
     }
   } else {
-    require(ctx.frames != nullptr, name(), ": the step has no world frames");
-    const auto it = ctx.frames->find(object_);
-    require(it != ctx.frames->end(), name(), ": the step inputs have no world frame '", object_, "'");
-    const WorldFrame& f = it->second;
+    require(ctx.frame() != nullptr, name(), ": the step inputs have no world frame '", object_, "'");
+    const WorldFrame& f = *ctx.frame();
     T = f.pose * shape_in_frame_;
     c.frame_pose = T;
     object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
@@ -153,7 +153,7 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
   if (dynamic_) c.object_t = ctx.bound[1].q_prev->bones[0];
   Vec3 v = Vec3::Zero(), w = Vec3::Zero(), origin = T.translation();
   if (!dynamic_) {
-    const WorldFrame& f = ctx.frames->at(object_);
+    const WorldFrame& f = *ctx.frame();
     v = f.linear_velocity, w = f.angular_velocity;
     origin = f.pose.translation() - v * ctx.h;  // the frame's origin at t
   }

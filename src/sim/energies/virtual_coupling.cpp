@@ -58,13 +58,10 @@ std::unique_ptr<TermCache> VirtualCouplingTerm::make_cache() const { return std:
 void VirtualCouplingTerm::begin_step(const StepContext& ctx) const {
   require(ctx.cache != nullptr, name(), ": no cache");
   CouplingCache& c = static_cast<CouplingCache&>(*ctx.cache);
-  const std::string frame = device_frame_name(tool_);
-  require(ctx.frames != nullptr, name(), ": the step has no world frames (expected '", frame, "')");
-  const auto it = ctx.frames->find(frame);
-  require(it != ctx.frames->end(), name(), ": the step has no world frame '", frame, "'");
-  const WorldFrame& f = it->second;
+  require(ctx.frame() != nullptr, name(), ": the step has no world frame '", device_frame_name(tool_), "'");
+  const WorldFrame& f = *ctx.frame();
   require(f.pose.matrix().allFinite() && f.linear_velocity.allFinite() && f.angular_velocity.allFinite(), name(),
-          ": world frame '", frame, "' is not finite");
+          ": world frame '", device_frame_name(tool_), "' is not finite");
   require(ctx.q_prev.bones.size() == 1, name(), ": the tool must be a rigid body (one bone)");
   c.d = f.pose.translation();
   c.R_d = f.pose.linear();

@@ -20,16 +20,17 @@
 //     the forces on flesh and tool are equal and opposite.
 //
 // Which anchors exist is per-step data (grasping and releasing does not
-// rebuild the model): it travels in StepInputs::frames, one named world frame
-// per anchor, `anchor_frame_name(tool, point)` = "<tool>/anchor/<point>":
-//   * kinematic tool: the frame's origin is the tool point a_p at t + h
-//     (world), its linear velocity the point's velocity (m/s): a_p,t = a_p − h v;
-//   * dynamic tool: the frame's origin is the tool point at time t, G_t · o_p
-//     (world); its twist is ignored; o_p = G_t⁻¹ · origin.
-// add_anchor_frames() writes them from the tool's pose and twist and the
-// anchors' offsets in the tool frame. Since they are ordinary world frames,
-// the step's frame shift, copies of the State, and replay need nothing more.
-#include <map>
+// rebuild the model): it travels in StepInputs::anchors, the term's anchor
+// set (AnchorSetId: the model registers the set named after the term's
+// `tool`), one AnchorPoint per anchor (the term takes them by increasing
+// point, the last one given for a point):
+//   * kinematic tool: its position is the tool point a_p at t + h (world),
+//     its velocity the point's velocity (m/s): a_p,t = a_p − h v;
+//   * dynamic tool: its position is the tool point at time t, G_t · o_p
+//     (world); its velocity is ignored; o_p = G_t⁻¹ · position.
+// anchor_points() writes them from the tool's pose and twist and the
+// anchors' offsets in the tool frame. The term reads them as given (world)
+// and takes them into the step frame itself (StepContext::frame_origin).
 #include <string>
 #include <vector>
 
@@ -44,15 +45,12 @@ struct Anchor {
   Vec3 offset = Vec3::Zero();
 };
 
-/// "<tool>/anchor/<point>": the world frame that carries anchor `point` of `tool` for a step.
-std::string anchor_frame_name(const std::string& tool, int point);
-
-/// Adds one world frame per anchor to `frames` (header comment). Kinematic
-/// tool: `tool_pose` and `tool` twist at t + h (world; ω rad/s, v m/s of the
-/// frame's origin); dynamic tool: `tool_pose` = its body pose G_t at time t,
-/// twist ignored. Removes the tool's anchor frames of a previous step first.
-void add_anchor_frames(const std::string& tool, const WorldFrame& tool_frame, const std::vector<Anchor>& anchors,
-                       bool dynamic_tool, std::map<std::string, WorldFrame>& frames);
+/// Sets `points` to one AnchorPoint per anchor, in order (header comment).
+/// Kinematic tool: `tool_frame` is the tool's pose and twist at t + h (world;
+/// ω rad/s, v m/s of the frame's origin); dynamic tool: its body pose G_t at
+/// time t, twist ignored.
+void anchor_points(const WorldFrame& tool_frame, const std::vector<Anchor>& anchors, bool dynamic_tool,
+                   std::vector<AnchorPoint>& points);
 
 struct AnchorOptions {
   double hardness = 1.0e3;  ///< k, N/m per anchor (> 0)
@@ -62,14 +60,15 @@ struct AnchorOptions {
 class AnchorTerm : public EnergyTerm {
  public:
   /// `points`: the flesh points anchors may use (e.g. PosedPoints::at_surface:
-  /// anchors then name skin vertices); `tool`: the tool's name (its anchors'
-  /// frames are "<tool>/anchor/<point>"); `dynamic_tool`: the tool is the
-  /// term's second bound body. Throws on a non-positive hardness or negative damping.
+  /// anchors then name skin vertices); `tool`: the tool's name (also the name
+  /// of the term's anchor set); `dynamic_tool`: the tool is the term's second
+  /// bound body. Throws on a non-positive hardness or negative damping.
   AnchorTerm(std::string tool, PosedPoints points, bool dynamic_tool, const AnchorOptions& options = {});
   std::string name() const override { return "anchor:" + tool_; }
+  std::string input_anchor_set() const override { return tool_; }
   std::unique_ptr<TermCache> make_cache() const override;
-  /// Reads the step's anchors from ctx.frames (none: inactive; a point index
-  /// out of range throws naming the frame).
+  /// Reads the step's anchors from ctx.anchors (none: inactive; a point
+  /// index out of range or a non-finite point throws naming the term).
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;

@@ -67,7 +67,7 @@
 // releases without a pop). The displacement at t + h is the minimizer at the
 // step's final q, fixed when the integrator asks for the report.
 //
-// Objects: static, kinematic (a named world frame of the step inputs) or
+// Objects: static, kinematic (a world frame of the step inputs) or
 // dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
 #include <memory>
 #include <string>
@@ -112,13 +112,17 @@ class ContactPatchTerm : public EnergyTerm {
  public:
   /// `field` in the object's shape frame, placed by the world frame `object`
   /// of the step inputs times `shape_in_frame`. Throws on bad options (one line).
-  /// The object is static or kinematic (a named world frame of the step
+  /// The object is static or kinematic (a world frame of the step
   /// inputs, placed by `shape_in_frame`), or, when `dynamic_object`, a rigid
   /// body of the model bound second (its configuration's bone 0 times
   /// `shape_in_frame`; equal and opposite forces, as sdf_contact.hpp).
   ContactPatchTerm(std::string object, const Avatar& avatar, geometry::SdfPtr field, const Isometry& shape_in_frame,
                    bool dynamic_object, const ContactPatchOptions& options = {});
   std::string name() const override { return "contact:" + object_; }
+  /// Static or kinematic: the world frame `object`; dynamic: none.
+  std::vector<std::string> input_frames() const override {
+    return dynamic_ ? std::vector<std::string>{} : std::vector<std::string>{object_};
+  }
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;

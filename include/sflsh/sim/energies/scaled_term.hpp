@@ -22,6 +22,8 @@ class ScaledTerm final : public EnergyTerm {
   ScaledTerm(std::shared_ptr<const EnergyTerm> inner, double scale);
   std::string name() const override { return inner_->name(); }
   BodyBlocks blocks() const override { return inner_->blocks(); }
+  std::vector<std::string> input_frames() const override { return inner_->input_frames(); }
+  std::string input_anchor_set() const override { return inner_->input_anchor_set(); }
   std::unique_ptr<TermCache> make_cache() const override { return inner_->make_cache(); }
   void begin_step(const StepContext& ctx) const override { inner_->begin_step(ctx); }
   bool active(const StepContext& ctx) const override { return inner_->active(ctx); }

@@ -10,9 +10,9 @@
 // through the coupled solve.
 //
 // The object is either
-//   * static or kinematic: a named world frame of the step inputs
-//     (StepInputs::frames[object]) gives T at t + h; the term is bound to the
-//     body alone;
+//   * static or kinematic: the world frame `object` of the step inputs
+//     (its input frame, StepInputs::frames) gives T at t + h; the term is
+//     bound to the body alone;
 //   * dynamic: a rigid-object body of the model (model.hpp), bound second;
 //     T = G_object · shape_in_frame at the current iterate (a shape that
 //     moves on its body, like a gripper's jaw, gives its pose for the step as
@@ -81,6 +81,8 @@ class SdfContactTerm : public EnergyTerm {
   SdfContactTerm(std::string object, PosedPoints samples, geometry::SdfPtr field, const Isometry& shape_in_frame,
                  bool dynamic_object, const SdfContactOptions& options = {});
   std::string name() const override { return "contact:" + object_; }
+  /// Static or kinematic: `object`; dynamic: its moving shape's frame (optional).
+  std::vector<std::string> input_frames() const override;
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;

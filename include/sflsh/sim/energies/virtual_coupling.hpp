@@ -18,8 +18,9 @@
 // (∂log/∂ω = J_l⁻¹), the exact second derivative of the trace term with its
 // negative eigenvalues (angles beyond 90°) clamped to 0.
 //
-// The device's pose is a named world frame of the step, `device_frame_name(tool)`
-// = "<tool>/device": pose at t + h, twist (m/s, rad/s world) over the step.
+// The device's pose is the term's input frame, the world frame
+// `device_frame_name(tool)` = "<tool>/device" of the step inputs: pose at
+// t + h, twist (m/s, rad/s world) over the step.
 // The term is bound to the tool body alone (its one bone, 6 DoFs).
 #include <string>
 
@@ -43,6 +44,7 @@ class VirtualCouplingTerm : public EnergyTerm {
   VirtualCouplingTerm(std::string tool, const VirtualCouplingOptions& options);
   std::string name() const override { return "coupling:" + tool_; }
   BodyBlocks blocks() const override { return BodyBlocks::Bones; }
+  std::vector<std::string> input_frames() const override { return {device_frame_name(tool_)}; }
   std::unique_ptr<TermCache> make_cache() const override;
   /// Reads the device frame (throws naming it when it is missing or not finite).
   void begin_step(const StepContext& ctx) const override;
