@@ -199,7 +199,7 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
   const bool coupled = t.coupled();
   t.frame = mb.add_frame(coupled ? device_frame_name(d.name) : d.name);
   for (size_t j = 0; j < d.jaws.size(); ++j) {
-    CompiledJaw jaw{d.name + "/jaw" + std::to_string(j), {}, Isometry::Identity(), d.jaws[j].side};
+    CompiledJaw jaw{d.name + "/jaw" + std::to_string(j), {}, Isometry::Identity(), d.jaws[j].side, {}};
     jaw.model = tool_shape(jaw.name, d.jaws[j].shape);
     jaw.offset.translation() = d.jaws[j].offset;
     jaw.frame = mb.add_frame(coupled ? moving_shape_frame_name(jaw.name) : jaw.name);

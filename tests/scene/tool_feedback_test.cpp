@@ -99,7 +99,9 @@ TEST_F(ToolFeedback, EachToolFeelsExactlyTheTermsActingOnIt) {
       const SceneToolState& ts = s.tool_state(i);
       EXPECT_LT((ts.force - force).norm(), 1e-12 * (1 + force.norm())) << d.name << " at step " << s.steps_done();
       EXPECT_EQ(ts.anchors, anchors) << d.name;
-      if (d.coupled) EXPECT_LT((ts.feedback_force + coupling).norm(), 1e-12 * (1 + coupling.norm())) << d.name;
+      if (d.coupled) {
+        EXPECT_LT((ts.feedback_force + coupling).norm(), 1e-12 * (1 + coupling.norm())) << d.name;
+      }
       felt[d.name] = felt[d.name] || force.norm() > 1e-3;
     }
     for (const TermQuantityReport& q : rep.quantities)

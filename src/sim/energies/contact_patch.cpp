@@ -170,9 +170,67 @@ void ContactPatchTerm::select_patch_nodes(TermCache& cache, const std::vector<in
   }
 }
 
+/// The candidate faces (every skin face of a near vertex), their samples and
+/// their distinct vertices.
+void ContactPatchTerm::collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  std::vector<char> face_mark(a.surface_faces.rows(), 0);
+  c.faces.clear();
+  for (int v : near)
+    for (int fc : vertex_faces_[v])
+      if (!face_mark[fc]) face_mark[fc] = 1, c.faces.push_back(fc);
+  std::sort(c.faces.begin(), c.faces.end());
+  c.samples.clear();
+  c.face_first.assign(1, 0);
+  c.vertices.clear();
+  c.vertex_slot.clear();
+  for (int fc : c.faces) {
+    append_face_samples(a.surface_rest, a.surface_faces, fc, options_.spacing, c.samples);
+    c.face_first.push_back(int(c.samples.size()));
+    for (int i = 0; i < 3; ++i) {
+      const int v = a.surface_faces(fc, i);
+      if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
+    }
+  }
+}
+
+/// The patch tets (with a patch node), each one's nodes as indices into the
+/// distinct nodes of the patch tets, their patch slots and the material's
+/// small-strain Hessian; the patch nodes sorted.
+void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  std::sort(c.nodes.begin(), c.nodes.end());
+  c.node_slot.clear();
+  for (int i = 0; i < int(c.nodes.size()); ++i) c.node_slot[c.nodes[i]] = i;
+  std::vector<char> tet_mark(a.tet.num_elements(), 0);
+  c.tets.clear();
+  for (int n : c.nodes)
+    for (int t : node_tets_[n])
+      if (!tet_mark[t]) tet_mark[t] = 1, c.tets.push_back(t);
+  std::sort(c.tets.begin(), c.tets.end());
+  c.tet_nodes.clear();
+  c.tet_local.assign(c.tets.size(), {});
+  c.tet_slot.assign(c.tets.size(), {});
+  c.tet_H2.resize(c.tets.size());
+  std::unordered_map<int, int> tet_node_index;
+  for (size_t i = 0; i < c.tets.size(); ++i) {
+    const int t = c.tets[i];
+    for (int k = 0; k < 4; ++k) {
+      const int n = a.tet.elements(t, k);
+      const auto [it, added] = tet_node_index.emplace(n, int(c.tet_nodes.size()));
+      if (added) c.tet_nodes.push_back(n);
+      c.tet_local[i][size_t(k)] = it->second;
+      const auto s = c.node_slot.find(n);
+      c.tet_slot[i][size_t(k)] = s == c.node_slot.end() ? -1 : s->second;
+    }
+    c.tet_H2[i] = linearized_hessian(materials_[t]);
+  }
+}
+
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   PatchCache& c = patch_cache(ctx, name());
-  const Avatar& a = *avatar_;
   // The displacement fixed at the end of the last step becomes the one at t.
   for (auto it = c.history.begin(); it != c.history.end();) {
     PatchHistory& h = it->second;
@@ -245,54 +303,9 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     near.swap(n2);
     near_phi.swap(p2);
   }
-  // Candidate faces and their samples.
-  std::vector<char> face_mark(a.surface_faces.rows(), 0);
-  c.faces.clear();
-  for (int v : near)
-    for (int fc : vertex_faces_[v])
-      if (!face_mark[fc]) face_mark[fc] = 1, c.faces.push_back(fc);
-  std::sort(c.faces.begin(), c.faces.end());
-  c.samples.clear();
-  c.face_first.assign(1, 0);
-  c.vertices.clear();
-  c.vertex_slot.clear();
-  for (int fc : c.faces) {
-    append_face_samples(a.surface_rest, a.surface_faces, fc, options_.spacing, c.samples);
-    c.face_first.push_back(int(c.samples.size()));
-    for (int i = 0; i < 3; ++i) {
-      const int v = a.surface_faces(fc, i);
-      if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
-    }
-  }
+  collect_candidate_faces(c, near);
   select_patch_nodes(c, near, near_phi);
-  std::sort(c.nodes.begin(), c.nodes.end());
-  c.node_slot.clear();
-  for (int i = 0; i < int(c.nodes.size()); ++i) c.node_slot[c.nodes[i]] = i;
-  std::vector<char> tet_mark(a.tet.num_elements(), 0);
-  c.tets.clear();
-  for (int n : c.nodes)
-    for (int t : node_tets_[n])
-      if (!tet_mark[t]) tet_mark[t] = 1, c.tets.push_back(t);
-  std::sort(c.tets.begin(), c.tets.end());
-  // Each patch tet's nodes (as indices into the distinct nodes of the patch
-  // tets), their patch slots and the material's small-strain Hessian.
-  c.tet_nodes.clear();
-  c.tet_local.assign(c.tets.size(), {});
-  c.tet_slot.assign(c.tets.size(), {});
-  c.tet_H2.resize(c.tets.size());
-  std::unordered_map<int, int> tet_node_index;
-  for (size_t i = 0; i < c.tets.size(); ++i) {
-    const int t = c.tets[i];
-    for (int k = 0; k < 4; ++k) {
-      const int n = a.tet.elements(t, k);
-      const auto [it, added] = tet_node_index.emplace(n, int(c.tet_nodes.size()));
-      if (added) c.tet_nodes.push_back(n);
-      c.tet_local[i][size_t(k)] = it->second;
-      const auto s = c.node_slot.find(n);
-      c.tet_slot[i][size_t(k)] = s == c.node_slot.end() ? -1 : s->second;
-    }
-    c.tet_H2[i] = linearized_hessian(materials_[t]);
-  }
+  prepare_patch_tets(c);
   // Predictions and the warm start.
   const size_t P = c.nodes.size();
   c.x_star.assign(P, Vec3::Zero());
@@ -460,57 +473,6 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
       if (k != l) (*hess)(rows[l], rows[k]) -= S(int(k), int(l));
     }
   return E;
-}
-
-std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const Configuration& q) const {
-  PatchCache& c = patch_cache(ctx, name());
-  const VecX du = minimize_patch(ctx, q);
-  Evaluation ev;
-  EvaluationMode mode;
-  mode.p_derivatives = false;
-  evaluate_patch(ctx, q, du, mode, ev);
-  double max_du = 0;
-  VecX packed(4 * c.nodes.size());
-  for (size_t i = 0; i < c.nodes.size(); ++i) {
-    const int n = c.nodes[i];
-    PatchHistory& h = c.history[n];
-    h.du_next = du.segment<3>(3 * i);
-    h.d_next = skinning_rotation_blend(avatar_->node_weights.row(n), q.bones) * h.du_next;
-    max_du = std::max(max_du, h.du_next.norm());
-    packed.segment<4>(4 * i) << double(n), h.du_next;
-  }
-  return {{"force", "N", ev.force},
-          {"active_samples", "", VecX::Constant(1, ev.active)},
-          {"max_penetration", "m", VecX::Constant(1, ev.depth)},
-          {"contact_area", "m^2", VecX::Constant(1, ev.area)},
-          {"patch_nodes", "", VecX::Constant(1, double(c.nodes.size()))},
-          {"max_patch_displacement", "m", VecX::Constant(1, max_du)},
-          {"patch_displacement", "m", packed},
-          {"patch_iterations", "", VecX::Constant(1, c.inner_iterations)},
-          {"patch_minimizations", "", VecX::Constant(1, c.minimizations)}};
-}
-
-Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {
-  std::unordered_map<int, Vec3> du;
-  for (const TermQuantityReport& q : report.quantities) {
-    if (q.body != body || q.name != "patch_displacement") continue;
-    require(q.value.size() % 4 == 0, "patch_surface_displacement: '", q.term, "' reports ", q.value.size(),
-            " values, expected 4 per patch node");
-    for (size_t i = 0; i < q.value.size(); i += 4) {
-      const int n = int(q.value[i]);
-      require(n >= 0 && n < a.tet.num_nodes(), "patch_surface_displacement: node ", n, " out of [0, ",
-              a.tet.num_nodes(), ")");
-      du.try_emplace(n, Vec3::Zero()).first->second += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
-    }
-  }
-  Points u = Points::Zero(a.surface_rest.rows(), 3);
-  if (du.empty()) return u;
-  for (int v = 0; v < u.rows(); ++v)
-    for (int c = 0; c < 4; ++c) {
-      const auto it = du.find(a.tet.elements(a.surface_tet[v], c));
-      if (it != du.end()) u.row(v) += a.surface_bary(v, c) * it->second.transpose();
-    }
-  return u;
 }
 
 }  // namespace sflsh

@@ -166,6 +166,9 @@ class ContactPatchTerm : public EnergyTerm {
   /// (PSD-projected) is the stiffness the cross block Φ_zp takes for the tet
   /// (the remainder's weight capped at the tet's own volume).
   double subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
+  // begin_step's parts (contact_patch.cpp), each filling the term's cache:
+  void collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const;
+  void prepare_patch_tets(TermCache& cache) const;
   /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
   void select_patch_nodes(TermCache& cache, const std::vector<int>& seeds, const std::vector<double>& seed_phi) const;
   /// The dynamic object's 6 DoFs in the term's local system, or −1.

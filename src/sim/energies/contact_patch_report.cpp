@@ -1,0 +1,66 @@
+// What the patch term reports after a step, and the skin displacement its
+// patches add (contact_patch.hpp).
+#include <algorithm>
+
+#include "sflsh/sim/energies/contact_patch.hpp"
+#include "sflsh/sim/posed_points.hpp"
+#include "sim/energies/contact_patch_cache.hpp"
+
+namespace sflsh {
+
+using contact_patch_detail::patch_cache;
+using contact_patch_detail::PatchCache;
+using contact_patch_detail::PatchHistory;
+
+std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const Configuration& q) const {
+  PatchCache& c = patch_cache(ctx, name());
+  const VecX du = minimize_patch(ctx, q);
+  Evaluation ev;
+  EvaluationMode mode;
+  mode.p_derivatives = false;
+  evaluate_patch(ctx, q, du, mode, ev);
+  double max_du = 0;
+  VecX packed(4 * c.nodes.size());
+  for (size_t i = 0; i < c.nodes.size(); ++i) {
+    const int n = c.nodes[i];
+    PatchHistory& h = c.history[n];
+    h.du_next = du.segment<3>(3 * i);
+    h.d_next = skinning_rotation_blend(avatar_->node_weights.row(n), q.bones) * h.du_next;
+    max_du = std::max(max_du, h.du_next.norm());
+    packed.segment<4>(4 * i) << double(n), h.du_next;
+  }
+  return {{"force", "N", ev.force},
+          {"active_samples", "", VecX::Constant(1, ev.active)},
+          {"max_penetration", "m", VecX::Constant(1, ev.depth)},
+          {"contact_area", "m^2", VecX::Constant(1, ev.area)},
+          {"patch_nodes", "", VecX::Constant(1, double(c.nodes.size()))},
+          {"max_patch_displacement", "m", VecX::Constant(1, max_du)},
+          {"patch_displacement", "m", packed},
+          {"patch_iterations", "", VecX::Constant(1, c.inner_iterations)},
+          {"patch_minimizations", "", VecX::Constant(1, c.minimizations)}};
+}
+
+Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {
+  std::unordered_map<int, Vec3> du;
+  for (const TermQuantityReport& q : report.quantities) {
+    if (q.body != body || q.name != "patch_displacement") continue;
+    require(q.value.size() % 4 == 0, "patch_surface_displacement: '", q.term, "' reports ", q.value.size(),
+            " values, expected 4 per patch node");
+    for (size_t i = 0; i < q.value.size(); i += 4) {
+      const int n = int(q.value[i]);
+      require(n >= 0 && n < a.tet.num_nodes(), "patch_surface_displacement: node ", n, " out of [0, ",
+              a.tet.num_nodes(), ")");
+      du.try_emplace(n, Vec3::Zero()).first->second += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
+    }
+  }
+  Points u = Points::Zero(a.surface_rest.rows(), 3);
+  if (du.empty()) return u;
+  for (int v = 0; v < u.rows(); ++v)
+    for (int c = 0; c < 4; ++c) {
+      const auto it = du.find(a.tet.elements(a.surface_tet[v], c));
+      if (it != du.end()) u.row(v) += a.surface_bary(v, c) * it->second.transpose();
+    }
+  return u;
+}
+
+}  // namespace sflsh
