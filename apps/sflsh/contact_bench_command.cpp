@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 
 #include "command.hpp"
 #include "sflsh/bench/contact_benchmark.hpp"
@@ -21,6 +22,7 @@ struct ContactBenchArgs {
   std::vector<int> handles;
   std::vector<std::string> scenes;
   int newton_iters = 1;
+  std::optional<double> nonlinearity_tolerance;
   double pressure_stiffness = kDefaultPressureStiffness, spacing = kDefaultContactSpacing;
   double patch_radius = ContactPatchOptions().patch_radius;
   bool no_patch = false, cpu_time = false;
@@ -36,6 +38,7 @@ void run_contact_bench(const ContactBenchArgs& a) {
   ContactBenchOptions o;
   o.settings.quick = a.quick;
   o.settings.newton_iters = a.newton_iters;
+  o.settings.nonlinearity_tolerance = a.nonlinearity_tolerance;
   o.settings.scenes = a.scenes;
   o.settings.pressure_stiffness = a.pressure_stiffness;
   o.settings.spacing = a.spacing;
@@ -46,6 +49,8 @@ void run_contact_bench(const ContactBenchArgs& a) {
   require(std::isfinite(a.patch_radius) && a.patch_radius > 0, "--patch-radius must be a positive number of m, got ",
           a.patch_radius);
   require(a.newton_iters >= 1, "--newton-iters must be >= 1, got ", a.newton_iters);
+  require(!a.nonlinearity_tolerance || (std::isfinite(*a.nonlinearity_tolerance) && *a.nonlinearity_tolerance >= 0),
+          "--nonlinearity-tolerance must be a finite number >= 0, got ", a.nonlinearity_tolerance.value_or(0));
   o.model = a.model;
   if (!a.betas.empty()) o.betas = parse_betas(a.betas);
   o.handle_counts = a.handles;  // CLI11 checks each is a whole number in [1, 4096]
@@ -100,6 +105,9 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
                   "Scenes to run: pressed, impact, probe (2 cm, thigh), probe-thigh-1cm, probe-belly, probe-belly-1cm, "
                   "probe-calf, probe-calf-1cm (default: all)")
       ->delimiter(',');
+  cmd->add_option("--nonlinearity-tolerance", a->nonlinearity_tolerance,
+                  "Reduced solver: an extra Newton iteration when the energy's change departs from the quadratic "
+                  "model by more than this share (default automatic; 0: never)");
   cmd->add_option("--newton-iters", a->newton_iters, "Reduced solver's Newton iterations per step")
       ->capture_default_str();
   cmd->add_option("--pressure-stiffness", a->pressure_stiffness,
@@ -129,6 +137,8 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
                   a->pressure_stiffness != kDefaultPressureStiffness ? std::to_string(a->pressure_stiffness).c_str() : "");
     a->command_line += extra;
     if (a->cpu_time) a->command_line += " --cpu-time";
+    if (a->nonlinearity_tolerance)
+      a->command_line += " --nonlinearity-tolerance " + std::to_string(*a->nonlinearity_tolerance);
     if (a->spacing != kDefaultContactSpacing) a->command_line += " --spacing " + std::to_string(a->spacing);
     if (a->patch_radius != ContactPatchOptions().patch_radius)
       a->command_line += " --patch-radius " + std::to_string(a->patch_radius);

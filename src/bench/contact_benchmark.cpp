@@ -197,6 +197,7 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
   mo.gravity = Vec3::Zero();
   mo.newton.iterations = o.newton_iters;
   mo.newton.line_search = o.newton_iters > 1;
+  mo.newton.nonlinearity_tolerance = o.nonlinearity_tolerance;
   mo.parallel_groups = false;
   ModelBuilder mb(mo);
   const int body = mb.add_body({"avatar", avatar, false});

@@ -353,6 +353,8 @@ TEST_F(BadInputMatrix, EveryEntryPointRejectsBadInputWithOneLine) {
       {"bench-contact --quick --handles 0 --out " + f("bc"), {"--handles"}, {f("bc")}},
       {"bench-contact --quick --handles 1000000 --out " + f("bc"), {"--handles"}, {f("bc")}},
       {"bench-contact --quick --newton-iters 0 --out " + f("bc"), {"--newton-iters"}, {f("bc")}},
+      {"bench-contact --quick --nonlinearity-tolerance -1 --out " + f("bc"), {"--nonlinearity-tolerance"}, {f("bc")}},
+      {"bench-contact --quick --nonlinearity-tolerance nan --out " + f("bc"), {"--nonlinearity-tolerance"}, {f("bc")}},
       {"bench-contact --quick --pressure-stiffness nan --out " + f("bc"), {"--pressure-stiffness"}, {f("bc")}},
       {"bench-contact --quick --pressure-stiffness 0 --out " + f("bc"), {"--pressure-stiffness"}, {f("bc")}},
       {"bench-contact --quick --patch-radius -1 --out " + f("bc"), {"--patch-radius"}, {f("bc")}},

@@ -40,6 +40,7 @@
 //   step_ratio  = median reduced step time over the steps with contact /
 //                 median step time of the same steps of the scene without the object.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,9 @@ namespace sflsh {
 struct ContactBenchSettings {
   bool quick = false;            ///< shorter scenes (pressed 0.25 s + 0.1 s hold; impact 0.1 s)
   int newton_iters = 1;          ///< reduced solver's Newton iterations per step (1: the default simulator)
+  /// The reduced solver's NewtonOptions::nonlinearity_tolerance (unset: automatic;
+  /// 0: never an extra Newton iteration).
+  std::optional<double> nonlinearity_tolerance;
   double pressed_radius = 0.08;  ///< m
   double pressed_depth = 0.03;   ///< m, final depth below the undeformed belly
   double impact_radius = 0.11;   ///< m
