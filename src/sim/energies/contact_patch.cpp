@@ -227,6 +227,29 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
     }
     c.tet_H2[i] = linearized_hessian(materials_[t]);
   }
+  std::vector<std::vector<int>> slots(c.tet_nodes.size());
+  for (size_t i = 0; i < c.tets.size(); ++i)
+    for (int k = 0; k < 4; ++k)
+      for (int l = 0; l < 4; ++l)
+        if (c.tet_slot[i][size_t(l)] >= 0) slots[size_t(c.tet_local[i][size_t(k)])].push_back(c.tet_slot[i][size_t(l)]);
+  c.cross_first.assign(1, 0);
+  c.cross_slot.clear();
+  for (std::vector<int>& s : slots) {
+    std::sort(s.begin(), s.end());
+    s.erase(std::unique(s.begin(), s.end()), s.end());
+    c.cross_slot.insert(c.cross_slot.end(), s.begin(), s.end());
+    c.cross_first.push_back(int(c.cross_slot.size()));
+  }
+  c.tet_cross.assign(c.tets.size(), {});
+  for (size_t i = 0; i < c.tets.size(); ++i)
+    for (int k = 0; k < 4; ++k) {
+      const int n = c.tet_local[i][size_t(k)];
+      const auto first = c.cross_slot.begin() + c.cross_first[size_t(n)], last = c.cross_slot.begin() + c.cross_first[size_t(n) + 1];
+      for (int l = 0; l < 4; ++l) {
+        const int slot = c.tet_slot[i][size_t(l)];
+        c.tet_cross[i][size_t(4 * k + l)] = slot < 0 ? -1 : int(std::lower_bound(first, last, slot) - c.cross_slot.begin());
+      }
+    }
 }
 
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {

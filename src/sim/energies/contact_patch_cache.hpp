@@ -50,6 +50,11 @@ struct PatchCache : TermCache {
   // patch slots (−1: not a patch node), and the material's small-strain Hessian.
   std::vector<int> tet_nodes;                  // distinct nodes of the patch tets
   std::vector<std::array<int, 4>> tet_local, tet_slot;
+  // The (tet node, patch slot) pairs that share a patch tet, per tet node in
+  // increasing slot order ([cross_first[i], cross_first[i+1]) into cross_slot),
+  // and per patch tet the pair of each of its (k, l) node pairs (−1: l not a patch node).
+  std::vector<int> cross_first, cross_slot;
+  std::vector<std::array<int, 16>> tet_cross;
   std::vector<Mat9> tet_H2;
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
   std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node

@@ -179,7 +179,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   const int z0 = local_layout(ctx).z_offset();
   auto simulated = [&](int n) { return a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated); };
   // The subspace's displacement W_n z at each node of the patch's tets.
-  const size_t nt = c.tet_nodes.size(), np3 = size_t(du.size()) / 3;
+  const size_t nt = c.tet_nodes.size();
   std::vector<Vec3> us(nt, Vec3::Zero());
   for (size_t i = 0; i < nt; ++i)
     if (simulated(c.tet_nodes[i]))
@@ -188,8 +188,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   // Per tet node: ∂Φ/∂u_n and the cross blocks K0 against the patch slots,
   // taken through W once per node after the loop.
   std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());
-  std::vector<Mat3> node_cross(q_hessian ? nt * np3 : 0, Mat3::Zero());
-  std::vector<char> node_cross_used(node_cross.size(), 0);
+  std::vector<Mat3> node_cross(q_hessian ? c.cross_slot.size() : 0, Mat3::Zero());  // per (node, slot) pair
   const bool bulk_hessian = q_hessian && dilatation_cell_.size() > 0;
   std::vector<int> bulk_index(bulk_hessian ? size_t(a.num_handles()) : 0, -1);  // handle → compressed index
   std::vector<int> bulk_handles;
@@ -257,11 +256,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
       node_grad[size_t(local[k])] += V * ((P1 - P0) * gk);
       if (!q_hessian) continue;
       for (int l = 0; l < 4; ++l)
-        if (slot[l] >= 0) {
-          const size_t e = size_t(local[k]) * np3 + size_t(slot[l]);
-          node_cross[e] += K0[k][l];
-          node_cross_used[e] = 1;
-        }
+        if (slot[l] >= 0) node_cross[size_t(c.tet_cross[ti][size_t(4 * k + l)])] += K0[k][l];
     }
   }
   if (q_derivatives)
@@ -272,8 +267,8 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
         const int row = z0 + 3 * int(it.col());
         out.gq.segment<3>(row) += it.value() * node_grad[i];
         if (!q_hessian) continue;
-        for (size_t p = 0; p < np3; ++p)
-          if (node_cross_used[i * np3 + p]) out.Hqp.block<3, 3>(row, 3 * long(p)) += it.value() * node_cross[i * np3 + p];
+        for (int e = c.cross_first[i]; e < c.cross_first[i + 1]; ++e)
+          out.Hqp.block<3, 3>(row, 3 * long(c.cross_slot[size_t(e)])) += it.value() * node_cross[size_t(e)];
       }
     }
   if (bulk_hessian && !bulk_handles.empty()) {
