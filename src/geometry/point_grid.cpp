@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "sflsh/core/error.hpp"
@@ -71,6 +72,37 @@ void PointGrid::query(const Aabb& box, std::vector<int>& out) const {
         }
   }
   std::sort(out.begin(), out.end());
+}
+
+int PointGrid::nearest(const Vec3& x, double max_distance, double* distance) const {
+  double best = max_distance;
+  int found = -1;
+  if (points_.rows() > 0 && max_distance >= 0) {
+    const Eigen::Vector3i c = cell_of(x);
+    // Cells of ring k lie at least (k − 1) cells from x (x anywhere in its cell).
+    const int rings = int(std::ceil(max_distance / cell_)) + 1;
+    for (int k = 0; k <= rings; ++k) {
+      if (found >= 0 && best <= (k - 1) * cell_) break;
+      const Eigen::Vector3i a = (c.array() - k).max(lo_.array()), b = (c.array() + k).min(hi_.array());
+      for (int z = a.z(); z <= b.z(); ++z)
+        for (int y = a.y(); y <= b.y(); ++y)
+          for (int xx = a.x(); xx <= b.x(); ++xx) {
+            const Eigen::Vector3i d = Eigen::Vector3i(xx, y, z) - c;
+            if (d.cwiseAbs().maxCoeff() != k) continue;  // an inner ring's cell
+            const auto it = cells_.find(key(Eigen::Vector3i(xx, y, z)));
+            if (it == cells_.end()) continue;
+            for (int i = it->second.first; i < it->second.second; ++i) {
+              const double dist = (points_.row(order_[i]).transpose() - x).norm();
+              if (dist <= best && (found < 0 || dist < best || order_[i] < found)) {
+                best = dist;
+                found = order_[i];
+              }
+            }
+          }
+    }
+  }
+  if (distance) *distance = found >= 0 ? best : std::numeric_limits<double>::infinity();
+  return found;
 }
 
 std::vector<int> PointGrid::query(const Aabb& box) const {

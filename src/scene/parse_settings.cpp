@@ -9,7 +9,7 @@ namespace sflsh::scene_yaml {
 
 ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, const SceneDescription& scene) {
   const std::string key = "contact";
-  p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs", "patch"},
+  p.check_map(n, key, {"stiffness", "friction", "self_contact", "sample_spacing", "pairs", "patch", "bodies"},
               "the contact settings");
   ContactDescription c;
   if (const auto s = n["stiffness"]) {
@@ -36,6 +36,25 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
     if (c.patch && c.friction > 0)
       p.error(v, pk, "the contact patch is frictionless; set contact.friction: 0 to use it (friction is ", c.friction,
               ")");
+  }
+  if (const auto v = n["bodies"]) {
+    const std::string bk = "contact.bodies";
+    p.check_map(v, bk, {"model", "pressure_stiffness", "spacing", "core_radius"}, "the body-body contact settings");
+    if (const auto m = v["model"]) {
+      const std::string model = p.text(m, bk + ".model");
+      if (model == "skin")
+        c.body_model = ContactDescription::BodyModel::Skin;
+      else if (model == "capsules")
+        c.body_model = ContactDescription::BodyModel::Capsules;
+      else
+        p.error(m, bk + ".model", "expected 'skin' or 'capsules', got '", model, "'");
+    }
+    if (const auto r = v["pressure_stiffness"]) c.body_pressure_stiffness = p.positive(r, bk + ".pressure_stiffness");
+    if (const auto r = v["spacing"]) c.body_spacing = p.positive(r, bk + ".spacing");
+    if (const auto r = v["core_radius"]) {
+      c.core_radius = p.positive(r, bk + ".core_radius");
+      if (c.core_radius > 1) p.error(r, bk + ".core_radius", "expected a share in (0, 1], got ", c.core_radius);
+    }
   }
   if (const auto v = n["pairs"]) {
     const std::string pk = "contact.pairs";

@@ -14,6 +14,7 @@
 #include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/energies/skin_contact.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/damping.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
@@ -239,8 +240,15 @@ void add_body_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodies
       if (!a.desc->bones_dynamic && !b.desc->bones_dynamic) continue;  // nothing can move
       require(!a.avatar->capsules.empty() && !b.avatar->capsules.empty(), sc.path, ": bodies '", a.desc->name,
               "' and '", b.desc->name, "' collide, but an avatar has no bone capsules (/skeleton/capsules)");
-      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, b.avatar.get(),
-                                                             CapsuleContactOptions{c.body_body_stiffness, 2}),
+      const bool skin = c.body_model == ContactDescription::BodyModel::Skin;
+      if (skin) {
+        SkinContactOptions so;
+        so.pressure_stiffness = c.body_pressure_stiffness;
+        so.spacing = c.body_spacing;
+        mb.add_term(std::make_shared<const SkinContactTerm>(*a.avatar, *b.avatar, so), {a.model_index, b.model_index});
+      }
+      mb.add_term(std::make_shared<const CapsuleContactTerm>(
+                      *a.avatar, b.avatar.get(), CapsuleContactOptions{c.body_body_stiffness, 2, skin ? c.core_radius : 1.0}),
                   {a.model_index, b.model_index});
     }
     if (c.self_contact && a.desc->bones_dynamic && !a.avatar->capsules.empty())

@@ -188,6 +188,10 @@ std::string scene_description_yaml(const SceneDescription& scene) {
     e << YAML::Key << "patch" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "radius" << YAML::Value
       << num(c.patch_radius) << YAML::Key << "pressure_stiffness" << YAML::Value << num(c.pressure_stiffness)
       << YAML::Key << "spacing" << YAML::Value << num(c.patch_spacing) << YAML::EndMap;
+  e << YAML::Key << "bodies" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "model" << YAML::Value
+    << (c.body_model == ContactDescription::BodyModel::Skin ? "skin" : "capsules") << YAML::Key << "pressure_stiffness"
+    << YAML::Value << num(c.body_pressure_stiffness) << YAML::Key << "spacing" << YAML::Value << num(c.body_spacing)
+    << YAML::Key << "core_radius" << YAML::Value << num(c.core_radius) << YAML::EndMap;
   e << YAML::Key << "pairs" << YAML::Value;
   if (c.all_pairs) {
     e << "all";

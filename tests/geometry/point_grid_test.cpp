@@ -48,6 +48,38 @@ TEST(PointGrid, QueriesMatchBruteForce) {
   test::expect_error([&] { geometry::PointGrid(p, 0.0); }, {"cell size"});
 }
 
+TEST(PointGrid, NearestMatchesBruteForce) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.5, 0.5), reach(0.0, 0.4);
+  Points p(2000, 3);
+  for (int i = 0; i < p.rows(); ++i) p.row(i) << u(rng), 0.3 * u(rng), u(rng);  // a slab: empty cells around it
+  const geometry::PointGrid grid(p, 0.03);
+  int hits = 0, misses = 0;
+  for (int q = 0; q < 400; ++q) {
+    const Vec3 x(1.5 * u(rng), 1.5 * u(rng), 1.5 * u(rng));  // inside and outside the cloud's cells
+    const double max_distance = reach(rng);
+    int want = -1;
+    double want_d = max_distance;
+    for (int i = 0; i < p.rows(); ++i) {
+      const double d = (p.row(i).transpose() - x).norm();
+      if (d < want_d || (d == want_d && want < 0)) want = i, want_d = d;
+    }
+    double d = -1;
+    const int got = grid.nearest(x, max_distance, &d);
+    EXPECT_EQ(got, want) << "query " << q;
+    if (want >= 0) {
+      EXPECT_DOUBLE_EQ(d, want_d);
+      ++hits;
+    } else {
+      EXPECT_TRUE(std::isinf(d));
+      ++misses;
+    }
+  }
+  EXPECT_GT(hits, 50);  // both outcomes exercised
+  EXPECT_GT(misses, 50);
+  EXPECT_EQ(geometry::PointGrid(Points(0, 3), 0.1).nearest(Vec3::Zero(), 1.0), -1);
+}
+
 TEST(Aabb, ExtendInflateIntersectTransform) {
   Aabb b;
   EXPECT_TRUE(b.empty());

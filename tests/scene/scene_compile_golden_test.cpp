@@ -215,15 +215,18 @@ TEST_F(SceneCompileGolden, TeleopPinch) {
           "475744638fd3888d", "29678b6fc97123f1", "fabcba68b78a16da", 0}});
 }
 
+// Two bodies meet skin against skin (skin_contact@0,1) with the bone
+// capsules as cores (body_contact@0,1): the states re-pinned when that became
+// the default body-body contact (an intended change of the physics).
 TEST_F(SceneCompileGolden, TwoWalkers) {
   auto closer = [](SceneDescription& s) {
     s.bodies[0].offset.z() = -0.04;
     s.bodies[1].offset.z() = 0.04;
   };
   check({"two_walkers.yaml", closer, 6,
-         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; body_contact@0,1",
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; skin_contact@0,1; body_contact@0,1",
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
-          "55315353cb598496", "2530ffe84ae7a5c3", "14650fb0739d0383", 0}});
+          "55315353cb598496", "01c8b1cc52dcdbf9", "14650fb0739d0383", 0}});
 }
 
 TEST_F(SceneCompileGolden, MomentumBump) {
@@ -232,9 +235,31 @@ TEST_F(SceneCompileGolden, MomentumBump) {
     s.bodies[1].offset.z() = 0.04;
   };
   check({"figures/momentum_bump.yaml", closer, 6,
-         {"inertia@0; elastic@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; body_contact@0,1",
+         {"inertia@0; elastic@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; skin_contact@0,1; body_contact@0,1",
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
-          "bb69675050e51204", "ba417960e2c32032", "14650fb0739d0383", 0}});
+          "bb69675050e51204", "09e9f7343cfd680f", "14650fb0739d0383", 0}});
+}
+
+TEST_F(SceneCompileGolden, WalkerMeetsStander) {
+  auto closer = [](SceneDescription& s) {
+    s.bodies[0].offset.z() = -0.04;
+    s.bodies[1].offset.z() = 0.04;
+  };
+  check({"figures/walker_meets_stander.yaml", closer, 6,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; skin_contact@0,1; body_contact@0,1",
+          "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
+          "05c633c21398ea9f", "8b6d5cb8f0561b49", "14650fb0739d0383", 0}});
+}
+
+TEST_F(SceneCompileGolden, WalkerMeetsStanderWithCapsules) {
+  auto closer = [](SceneDescription& s) {
+    s.bodies[0].offset.z() = -0.04;
+    s.bodies[1].offset.z() = 0.04;
+  };
+  check({"figures/walker_meets_stander_capsules.yaml", closer, 6,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; body_contact@0,1",
+          "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
+          "05c633c21398ea9f", "aada448650dd38d2", "14650fb0739d0383", 0}});
 }
 
 TEST_F(SceneCompileGolden, PinchCoupled) {
@@ -357,5 +382,5 @@ TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
   for (const char* dir : {"apps/scenes", "apps/scenes/figures"})
     for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(test::source_dir()) / dir))
       scenes += e.path().extension() == ".yaml";
-  EXPECT_EQ(scenes, 12) << "a new example scene: add it to SceneCompileGolden";
+  EXPECT_EQ(scenes, 14) << "a new example scene: add it to SceneCompileGolden";
 }

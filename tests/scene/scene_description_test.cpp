@@ -418,6 +418,10 @@ SceneDescription full_scene(const SceneFolder& folder) {
   s.contact.sample_spacing = 0.015;
   s.contact.all_pairs = false;
   s.contact.pairs = {{"alice", "floor"}, {"ball", "alice"}, {"alice", "bob"}};
+  s.contact.body_model = ContactDescription::BodyModel::Capsules;
+  s.contact.body_pressure_stiffness = 2.5e8;
+  s.contact.body_spacing = 0.012;
+  s.contact.core_radius = 0.625;
 
   s.solver.dt = 1.0 / 90;
   s.solver.seconds = 2.5;
@@ -546,6 +550,10 @@ TEST(SceneDescription, FullRoundTripKeepsEveryField) {
   EXPECT_FIELD(contact.sample_spacing);
   EXPECT_FIELD(contact.all_pairs);
   EXPECT_FIELD(contact.pairs);
+  EXPECT_FIELD(contact.body_model);
+  EXPECT_FIELD(contact.body_pressure_stiffness);
+  EXPECT_FIELD(contact.body_spacing);
+  EXPECT_FIELD(contact.core_radius);
   EXPECT_FIELD(solver.dt);
   EXPECT_FIELD(solver.seconds);
   EXPECT_FIELD(solver.newton_iterations);
@@ -602,6 +610,35 @@ TEST(SceneDescription, ContactPatchKeysParseWriteBackAndRefuseBadValues) {
   expect_scene_error(body + "contact: {friction: 0, patch: {size: 1}}\n", {"scene.yaml:5:", "contact.patch", "size"});
 }
 
+// contact.bodies: skin by default; each key distinct from its default, written
+// back and read again the same; a model that is not skin or capsules, a
+// pressure stiffness or spacing <= 0 and a core radius outside (0, 1] refused.
+TEST(SceneDescription, BodyContactKeysParseWriteBackAndRefuseBadValues) {
+  const std::string body = "bodies:\n  - name: a\n    avatar: avatar.h5\nsolver: {seconds: 1}\n";
+  SceneFolder folder;
+  const ContactDescription d;
+  EXPECT_EQ(d.body_model, ContactDescription::BodyModel::Skin);
+  const SceneDescription set = parse_scene_description(
+      body + "contact: {bodies: {model: capsules, pressure_stiffness: 3.0e8, spacing: 0.006, core_radius: 0.7}}\n",
+      folder.file("set.yaml"));
+  for (const SceneDescription& s :
+       {set, parse_scene_description(scene_description_yaml(set), folder.file("again.yaml"))}) {
+    EXPECT_EQ(s.contact.body_model, ContactDescription::BodyModel::Capsules);
+    EXPECT_EQ(s.contact.body_pressure_stiffness, 3.0e8);
+    EXPECT_EQ(s.contact.body_spacing, 0.006);
+    EXPECT_EQ(s.contact.core_radius, 0.7);
+  }
+  EXPECT_NE(d.body_pressure_stiffness, 3.0e8);
+  EXPECT_NE(d.body_spacing, 0.006);
+  EXPECT_NE(d.core_radius, 0.7);
+  expect_scene_error(body + "contact: {bodies: {model: jelly}}\n", {"scene.yaml:5:", "contact.bodies.model", "'jelly'"});
+  expect_scene_error(body + "contact: {bodies: {pressure_stiffness: 0}}\n",
+                     {"scene.yaml:5:", "contact.bodies.pressure_stiffness"});
+  expect_scene_error(body + "contact: {bodies: {spacing: -0.01}}\n", {"scene.yaml:5:", "contact.bodies.spacing"});
+  expect_scene_error(body + "contact: {bodies: {core_radius: 1.5}}\n", {"scene.yaml:5:", "contact.bodies.core_radius", "(0, 1]"});
+  expect_scene_error(body + "contact: {bodies: {core_radius: .nan}}\n", {"scene.yaml:5:", "contact.bodies.core_radius"});
+  expect_scene_error(body + "contact: {bodies: {size: 1}}\n", {"scene.yaml:5:", "contact.bodies", "size"});
+}
 
 TEST(SceneDescription, PoseStreamRampInParsesWritesBackAndRefusesNegatives) {
   SceneFolder folder;

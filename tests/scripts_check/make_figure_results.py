@@ -147,9 +147,21 @@ def contact(variant, d):
     floor_end = (200.0, 664.0, 0.0) if variant == "floor_force_slanted" else (1.5, 664.0, 2.0)
     write(p("fall_on_floor.log"), steps_line(600) + contact_line("contact:floor", 4.2, 900.0, floor_end))
     if variant != "walkers_missing_line":
-        write(p("two_walkers.log"), steps_line(600) + contact_line("body_contact", 4.84, 500.0, (0, 0, 0)))
+        write(p("two_walkers.log"), steps_line(600) + contact_line("skin_contact", 3.9, 1018.7, (0, 0, 0)) +
+              contact_line("body_contact", 0.0, 0.0, (0, 0, 0)))
     else:
         write(p("two_walkers.log"), steps_line(600))
+    peak = 2500.0 if variant == "walker_spike" else 738.9
+    write(p("walker_meets_stander.log"), steps_line(300) + contact_line("skin_contact", 4.2, peak, (7.5, -6.8, -144.0)) +
+          contact_line("body_contact", 0.0, 0.0, (0, 0, 0)))
+    write(p("walker_meets_stander_capsules.log"), steps_line(300) +
+          contact_line("body_contact", 19.48, 49719.1, (24.5, 6.1, -165.6)))
+    joints = np.zeros((13, 48, 3))
+    joints[:, 0, 2] = np.linspace(-0.75, -0.40, 13)  # alice's pelvis approaches bob's (z = 0) and stops
+    if variant == "walker_passes":
+        joints[-1, 0, 2] = 0.05
+    with h5py.File(p("walker_meets_stander.h5"), "w") as h:
+        h["/frames/joints"] = joints
     change = "3.0e-03" if variant == "momentum_lost" else "1.9e-09"
     write(p("momentum_bump.log"), steps_line(600) + f"linear momentum: start 2.5800 kg m/s, end 2.5800 kg m/s (change {change})\n")
     write(p("pinch_from_file.log"), steps_line(1250) + "tools: peak force 119 N, largest anchor stretch 0.74 mm\n"

@@ -21,124 +21,14 @@
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sim/skeleton_fixture.hpp"
 #include "sim/synthetic_avatar.hpp"
+#include "sim/two_body_fixture.hpp"
+#include "test_support.hpp"
 
 using namespace sflsh;
+using namespace sflsh::test::two_body;
 
 namespace {
 
-constexpr double kH = 1.0 / 60.0;
-
-Avatar box(int handles = 6, int cells = 2, double cell = 0.04) {
-  test::SyntheticAvatarOptions o;
-  o.nx = o.nz = cells;
-  o.cell = cell;
-  o.handles = handles;
-  o.handle_radius = 0.1;
-  o.all_tets = false;
-  o.samples = 10;
-  Avatar a = test::make_synthetic_avatar(o);  // default: box x, z ∈ [−0.04, 0.04], y ∈ [0, 0.12]
-  a.joints_rest = test::make_tpose_skeleton().joints_rest;
-  a.capsules = {{3, Vec3(0, 0.03, 0), Vec3(0, 0.09, 0), 0.03}};
-  return a;
-}
-
-Isometry small_motion(std::mt19937& rng, double angle, double shift) {
-  std::normal_distribution<double> n;
-  Isometry G = Isometry::Identity();
-  G.linear() = Eigen::AngleAxisd(angle * n(rng), Vec3(n(rng), n(rng), n(rng)).normalized()).toRotationMatrix();
-  G.translation() = shift * Vec3(n(rng), n(rng), n(rng));
-  return G;
-}
-
-/// A configuration near rest: bones moved slightly, z random (m).
-Configuration near_rest(const Avatar& a, std::mt19937& rng, const Isometry& base = Isometry::Identity()) {
-  Configuration q;
-  for (int j = 0; j < 24; ++j) q.bones.push_back(base * small_motion(rng, 0.03, 0.003));
-  std::uniform_real_distribution<double> u(-0.004, 0.004);
-  q.z = VecX(a.num_reduced());
-  for (int i = 0; i < q.z.size(); ++i) q.z[i] = u(rng);
-  return q;
-}
-
-DofLayout body_layout(const Avatar& a, bool bones_dynamic, int base = 0) {
-  DofLayout l;
-  l.bones_dynamic = bones_dynamic;
-  l.num_reduced = a.num_reduced();
-  l.bone_pivots = a.joints_rest;
-  l.base = base;
-  return l;
-}
-
-DofLayout rigid_layout(int base) {
-  DofLayout l;
-  l.num_bones = 1;
-  l.bones_dynamic = true;
-  l.num_reduced = 0;
-  l.bone_pivots = Points::Zero(1, 3);
-  l.base = base;
-  return l;
-}
-
-/// A context binding the given bodies (configurations at t and t − h) with their local layouts.
-struct Bound {
-  const Avatar* avatar;
-  DofLayout layout;
-  Configuration q, q_prev, q_prev2;
-};
-StepContext bind_bodies(std::vector<Bound>& bodies, const std::map<std::string, WorldFrame>* frames) {
-  StepContext ctx;
-  ctx.avatar = bodies[0].avatar;
-  ctx.layout = bodies[0].layout;
-  ctx.h = kH;
-  ctx.q_prev = bodies[0].q_prev;
-  ctx.q_prev2 = bodies[0].q_prev2;
-  // The term's one input frame: the only one these tests give.
-  if (frames)
-    for (const auto& [name, f] : *frames) ctx.frames.push_back(&f);
-  for (size_t i = 0; i < bodies.size(); ++i)
-    ctx.bound.push_back({int(i), int(i), bodies[i].avatar, bodies[i].layout, &bodies[i].q, &bodies[i].q_prev,
-                         &bodies[i].q_prev2});
-  return ctx;
-}
-
-int total_size(const std::vector<Bound>& bodies) {
-  int n = 0;
-  for (const Bound& b : bodies) n += b.layout.size();
-  return n;
-}
-
-/// E at the bodies retracted by the global local-system step δ.
-double energy_at(const EnergyTerm& term, StepContext ctx, std::vector<Bound> bodies, const VecX& delta) {
-  std::vector<Configuration> q;
-  for (const Bound& b : bodies) q.push_back(retract(b.q, delta, b.layout));
-  for (size_t i = 0; i < bodies.size(); ++i) ctx.bound[i].q = &q[i];
-  return term.evaluate(ctx, q[0], nullptr, nullptr);
-}
-
-struct Derivatives {
-  double E;
-  VecX grad;
-  MatX hess;
-};
-Derivatives analytic(const EnergyTerm& term, const StepContext& ctx, const std::vector<Bound>& bodies) {
-  const int n = total_size(bodies);
-  Derivatives d{0, VecX::Zero(n), MatX::Zero(n, n)};
-  d.E = term.evaluate(ctx, bodies[0].q, &d.grad, &d.hess);
-  return d;
-}
-
-VecX fd_gradient(const EnergyTerm& term, const StepContext& ctx, const std::vector<Bound>& bodies, double eps) {
-  const int n = total_size(bodies);
-  VecX g(n);
-  for (int i = 0; i < n; ++i) {
-    VecX d = VecX::Zero(n);
-    d[i] = eps;
-    g[i] = (energy_at(term, ctx, bodies, d) - energy_at(term, ctx, bodies, -d)) / (2 * eps);
-  }
-  return g;
-}
-
-double rel(const VecX& a, const VecX& b) { return (a - b).norm() / std::max(1e-12, b.norm()); }
 
 TEST(SdfContact, GradientAndHessianAgainstAStaticSphereMatchFiniteDifferences) {
   const Avatar a = box();
@@ -577,6 +467,29 @@ TEST(CapsuleContact, NoEnergyAtAGapAndHalfKDepthSquaredInOverlap) {
     EXPECT_NEAR(d.E, 0.5 * k * depth * depth, 1e-12) << "shift " << shift;
     if (depth == 0.0) EXPECT_EQ(d.grad.norm(), 0.0) << "shift " << shift;
   }
+}
+
+TEST(CapsuleContact, CoresScaleEveryRadius) {
+  // radius_scale 0.5: the 3 cm capsules become 1.5 cm cores, so two parallel
+  // axes 5 cm apart (overlapping at full radius) do not touch, and 2.5 cm
+  // apart overlap by 3 − 2.5 = 0.5 cm: E = ½ k (5 mm)².
+  const Avatar a = box(), b = box();
+  const double k = 1.0e4;
+  const CapsuleContactTerm term(a, &b, {k, 2, 0.5});
+  for (const auto& [shift, depth] : {std::pair{0.05, 0.0}, std::pair{0.025, 0.005}}) {
+    Configuration qa, qb;
+    qa.bones.assign(24, Isometry::Identity());
+    qb.bones.assign(24, Isometry(Eigen::Translation3d(shift, 0, 0)));
+    qa.z = qb.z = VecX::Zero(0);
+    std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa}, {&b, body_layout(b, true), qb, qb, qb}};
+    for (Bound& bd : bodies) bd.layout.num_reduced = 0;
+    bodies[1].layout.base = bodies[0].layout.size();
+    StepContext ctx = bind_bodies(bodies, nullptr);
+    const auto cache = begin_term_step(term, ctx);
+    EXPECT_NEAR(analytic(term, ctx, bodies).E, 0.5 * k * depth * depth, 1e-12) << "shift " << shift;
+  }
+  test::expect_error([&] { CapsuleContactTerm(a, &b, {k, 2, 0.0}); }, {"capsule contact", "radius scale"});
+  test::expect_error([&] { CapsuleContactTerm(a, &b, {k, 2, 1.5}); }, {"capsule contact", "radius scale"});
 }
 
 TEST(CapsuleContact, AFastApproachIsCaughtByTheBroadPhaseAndTheForcePushesTheBodiesApart) {

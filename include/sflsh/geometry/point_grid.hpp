@@ -26,6 +26,12 @@ class PointGrid {
   void query(const Aabb& box, std::vector<int>& out) const;
   /// Convenience form of query().
   std::vector<int> query(const Aabb& box) const;
+  /// The point nearest x within `max_distance` (m): its index, or −1 when
+  /// none is that close; its distance goes to `distance`. Visits the cells in
+  /// rings of growing Chebyshev radius around x's cell and stops once no
+  /// farther ring can hold a nearer point, so a query costs what lies
+  /// between x and its nearest point.
+  int nearest(const Vec3& x, double max_distance, double* distance = nullptr) const;
 
   int num_points() const { return int(points_.rows()); }
   int num_cells() const { return int(cells_.size()); }

@@ -128,6 +128,7 @@
 #include "sflsh/core/types.hpp"
 #include "sflsh/geometry/sdf.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
+#include "sflsh/sim/energies/skin_contact.hpp"
 #include "sflsh/sim/newton_step.hpp"
 
 namespace sflsh {
@@ -290,6 +291,16 @@ struct ContactDescription {
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
   double pressure_stiffness = kDefaultPressureStiffness;      ///< N/m³
   double patch_spacing = kDefaultContactSpacing;              ///< m, face sample spacing
+  /// contact.bodies: how two bodies meet. Skin (default): skin against skin
+  /// with a pressure stiffness, the flesh of both giving
+  /// (sim/energies/skin_contact.hpp), and the bone capsules shrunk to cores
+  /// (`core_radius` of their radius) as a backstop; Capsules: bone capsules
+  /// alone (rigid, body_body_stiffness per pair).
+  enum class BodyModel { Skin, Capsules };
+  BodyModel body_model = BodyModel::Skin;
+  double body_pressure_stiffness = SkinContactOptions().pressure_stiffness;  ///< N/m³
+  double body_spacing = SkinContactOptions().spacing;                        ///< m
+  double core_radius = 0.5;  ///< share of each capsule's radius kept as its core (0, 1]
 };
 
 struct SolverDescription {

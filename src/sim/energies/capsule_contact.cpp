@@ -44,6 +44,10 @@ CapsuleContactTerm::CapsuleContactTerm(const Avatar& a, const Avatar* b, const C
   require(o.stiffness >= 0 && std::isfinite(o.stiffness), "capsule contact: stiffness ", o.stiffness,
           " N/m, expected >= 0");
   require(!caps_a_.empty() && !caps_b_.empty(), "capsule contact: an avatar has no bone capsules (/skeleton/capsules)");
+  require(o.radius_scale > 0 && o.radius_scale <= 1, "capsule contact: radius scale ", o.radius_scale,
+          ", expected in (0, 1]");
+  for (auto* caps : {&caps_a_, &caps_b_})
+    for (BoneCapsule& c : *caps) c.radius *= o.radius_scale;
   for (int i = 0; i < int(caps_a_.size()); ++i)
     for (int j = self_ ? i + 1 : 0; j < int(caps_b_.size()); ++j) {
       if (self_) {

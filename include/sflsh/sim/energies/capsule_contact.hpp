@@ -29,6 +29,9 @@ struct CapsuleContactOptions {
   /// Self-contact: skip pairs whose bones are at most this many edges apart
   /// in the skeleton tree (2: a bone, its parent, grandparent, siblings).
   int min_bone_separation = 2;
+  /// Each capsule's radius is scaled by this (0, 1]: below 1 the capsules are
+  /// cores, a backstop under a contact model that lets the flesh give (skin_contact.hpp).
+  double radius_scale = 1.0;
 };
 
 class CapsuleContactTerm : public EnergyTerm {

@@ -1,0 +1,281 @@
+#include "sflsh/sim/energies/skin_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sflsh/core/error.hpp"
+#include "sflsh/geometry/aabb.hpp"
+#include "sflsh/geometry/point_grid.hpp"
+#include "sflsh/geometry/triangle_closest_point.hpp"
+
+namespace sflsh {
+namespace {
+
+/// How far ahead of the last step's motion the broad phase looks: a pair
+/// approaching at the speed of its last step closes m_a + m_b over the next
+/// one; the rest (and the margin) covers its acceleration.
+constexpr double kMotionFactor = 1.5;
+
+struct PairCache : TermCache {
+  std::vector<SkinContactTerm::Pair> pairs;
+  // Scratch of compute(): one sample's row nᵀ(J_a − J_b) over the local DoFs.
+  VecX row;
+  std::vector<int> touched;
+  std::vector<char> mark;
+};
+
+SkinContactTerm::Skin make_skin(const Avatar& avatar, int max_handles) {
+  SkinContactTerm::Skin s;
+  s.vertices = PosedPoints::at_surface(avatar).with_truncated_rows(max_handles);
+  s.rest = avatar.surface_rest;
+  s.faces = avatar.surface_faces;
+  s.vertex_faces.assign(s.rest.rows(), {});
+  s.vertex_neighbours.assign(s.rest.rows(), {});
+  for (int f = 0; f < int(s.faces.rows()); ++f)
+    for (int c = 0; c < 3; ++c) {
+      s.vertex_faces[s.faces(f, c)].push_back(f);
+      s.max_edge = std::max(s.max_edge, (s.rest.row(s.faces(f, c)) - s.rest.row(s.faces(f, (c + 1) % 3))).norm());
+      s.vertex_neighbours[s.faces(f, c)].push_back(s.faces(f, (c + 1) % 3));
+      s.vertex_neighbours[s.faces(f, (c + 1) % 3)].push_back(s.faces(f, c));
+    }
+  for (auto& n : s.vertex_neighbours) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return s;
+}
+
+Vec3 face_point(const Points& x, const Triangles& faces, int f, const Vec3& l) {
+  return l[0] * x.row(faces(f, 0)).transpose() + l[1] * x.row(faces(f, 1)).transpose() +
+         l[2] * x.row(faces(f, 2)).transpose();
+}
+
+Vec3 face_normal(const Points& x, const Triangles& faces, int f) {
+  const Vec3 a = x.row(faces(f, 0)).transpose(), b = x.row(faces(f, 1)).transpose(), c = x.row(faces(f, 2)).transpose();
+  const Vec3 n = (b - a).cross(c - a);
+  const double len = n.norm();
+  return len > 0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+}  // namespace
+
+SkinContactTerm::SkinContactTerm(const Avatar& a, const Avatar& b, const SkinContactOptions& o) : options_(o) {
+  check_contact_sampling(o.pressure_stiffness, o.spacing, "skin contact");
+  require(std::isfinite(o.margin) && o.margin >= 0, "skin contact: margin ", o.margin, " m, expected >= 0");
+  require(std::isfinite(o.max_depth) && o.max_depth > 0, "skin contact: max depth ", o.max_depth, " m, expected > 0");
+  require(a.surface_faces.rows() > 0 && b.surface_faces.rows() > 0, "skin contact: an avatar has no skin faces");
+  skins_[0] = make_skin(a, o.max_handles);
+  skins_[1] = make_skin(b, o.max_handles);
+}
+
+double SkinContactTerm::gap(const Pair& p, const Configuration* const q[2]) const {
+  const Skin& from = skins_[p.side];
+  const Skin& to = skins_[1 - p.side];
+  Vec3 x = Vec3::Zero(), y = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    x += p.lambda[i] * from.vertices.world_point(from.faces(p.face, i), *q[p.side]);
+    y += p.mu[i] * to.vertices.world_point(to.faces(p.other_face, i), *q[1 - p.side]);
+  }
+  return p.normal.dot(x - y);
+}
+
+std::unique_ptr<TermCache> SkinContactTerm::make_cache() const { return std::make_unique<PairCache>(); }
+
+void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_from, const VecX& m_from,
+                                    const Skin& to, const Points& x_to, const VecX& m_to,
+                                    std::vector<Pair>& out) const {
+  // Reach of a vertex v of this skin: the margin plus twice its own motion
+  // over the last step and twice the fastest of the other skin's.
+  const double fastest_to = m_to.size() ? m_to.maxCoeff() : 0.0;
+  auto reach = [&](double m) { return options_.margin + kMotionFactor * (m + fastest_to); };
+  const double slack = to.max_edge;  // a surface point is within an edge of one of its face's vertices
+  const geometry::Aabb near_from =
+      geometry::Aabb::of_points(x_from).inflated(reach(m_from.size() ? m_from.maxCoeff() : 0.0) + slack);
+  std::vector<int> to_index;
+  for (int w = 0; w < int(x_to.rows()); ++w)
+    if (near_from.contains(x_to.row(w).transpose())) to_index.push_back(w);
+  if (to_index.empty()) return;
+  Points to_near(to_index.size(), 3);
+  for (size_t i = 0; i < to_index.size(); ++i) to_near.row(i) = x_to.row(to_index[i]);
+  const geometry::PointGrid grid(to_near, 0.02);
+  const geometry::Aabb near_to = geometry::Aabb::of_points(to_near);
+
+  // This skin's faces with a vertex within reach of the other skin's nearest
+  // vertex (margin plus kMotionFactor times the motion of both, plus an edge).
+  std::vector<char> candidate(from.faces.rows(), 0);
+  VecX nearest_to = VecX::Constant(x_from.rows(), std::numeric_limits<double>::infinity());
+  for (int v = 0; v < int(x_from.rows()); ++v) {
+    const Vec3 x = x_from.row(v).transpose();
+    const double r = reach(m_from[v]) + slack;
+    if (!near_to.inflated(r).contains(x)) continue;
+    const int w = grid.nearest(x, r, &nearest_to[v]);
+    if (w < 0 || nearest_to[v] > options_.margin + kMotionFactor * (m_from[v] + m_to[to_index[w]]) + slack) continue;
+    for (int f : from.vertex_faces[v]) candidate[f] = 1;
+  }
+
+  // Each candidate face's samples against the closest point of the other skin.
+  std::vector<SkinFaceSample> samples;
+  std::vector<int> faces_near;
+  for (int f = 0; f < int(from.faces.rows()); ++f) {
+    if (!candidate[f]) continue;
+    // A sample lies within an edge of its face's vertices, so its nearest
+    // vertex of the other skin is within that of theirs.
+    double m_sample = 0, nearest = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 3; ++c) {
+      m_sample = std::max(m_sample, m_from[from.faces(f, c)]);
+      nearest = std::min(nearest, nearest_to[from.faces(f, c)]);
+    }
+    samples.clear();
+    append_face_samples(from.rest, from.faces, f, options_.spacing, samples);
+    for (const SkinFaceSample& s : samples) {
+      const Vec3 x = face_point(x_from, from.faces, f, s.lambda);
+      // The nearest vertex of the other skin, and the faces around it and its
+      // neighbours: the closest point of a smooth skin lies on one of them.
+      const int w_near = grid.nearest(x, nearest + from.max_edge);
+      if (w_near < 0) continue;
+      const int w = to_index[w_near];
+      faces_near.assign(to.vertex_faces[w].begin(), to.vertex_faces[w].end());
+      for (int u : to.vertex_neighbours[w]) faces_near.insert(faces_near.end(), to.vertex_faces[u].begin(), to.vertex_faces[u].end());
+      std::sort(faces_near.begin(), faces_near.end());
+      faces_near.erase(std::unique(faces_near.begin(), faces_near.end()), faces_near.end());
+      double best = std::numeric_limits<double>::infinity();
+      Pair p;
+      for (int g : faces_near) {
+        const Vec3 mu = geometry::closest_point_on_triangle(
+            x, x_to.row(to.faces(g, 0)).transpose(), x_to.row(to.faces(g, 1)).transpose(),
+            x_to.row(to.faces(g, 2)).transpose());
+        const double d = (x - face_point(x_to, to.faces, g, mu)).norm();
+        if (d < best) {
+          best = d;
+          p.other_face = g;
+          p.mu = mu;
+        }
+      }
+      if (!(best < std::numeric_limits<double>::infinity())) continue;
+      double m_other = 0;
+      for (int c = 0; c < 3; ++c) m_other = std::max(m_other, m_to[to.faces(p.other_face, c)]);
+      // The normal: the face's where the closest point is inside it, else
+      // (an edge or a corner) the direction from it to the sample, signed by
+      // the face's side, so that the gap is the signed distance at time t and
+      // the pair's forces are collinear there. Surfaces that face the same
+      // way (coplanar neighbours, a sample on the far side) do not touch.
+      const Vec3 face_n = face_normal(x_to, to.faces, p.other_face);
+      const Vec3 offset = x - face_point(x_to, to.faces, p.other_face, p.mu);
+      p.normal = face_n;
+      if ((p.mu.array() <= 0).any() && best > 1e-9) p.normal = (face_n.dot(offset) < 0 ? -1.0 : 1.0) * offset / best;
+      if (face_normal(x_from, from.faces, f).dot(face_n) > 0) continue;
+      const double gap = p.normal.dot(offset);
+      if (gap > options_.margin + kMotionFactor * (m_sample + m_other) || gap < -options_.max_depth) continue;
+      p.side = side;
+      p.face = f;
+      p.lambda = s.lambda;
+      p.area = s.area;
+      out.push_back(p);
+    }
+  }
+}
+
+void SkinContactTerm::begin_step(const StepContext& ctx) const {
+  auto& c = static_cast<PairCache&>(*ctx.cache);
+  c.pairs.clear();
+  require(ctx.bound.size() == 2u, name(), ": bound to ", ctx.bound.size(), " bodies, expected 2");
+  Points x[2];
+  VecX motion[2];
+  for (int k = 0; k < 2; ++k) {
+    const BoundBody& b = ctx.bound[k];
+    x[k] = skins_[k].vertices.world(*b.q_prev);
+    motion[k] = VecX::Zero(x[k].rows());
+    if (b.q_prev2 && b.q_prev2->bones.size() == b.q_prev->bones.size())
+      motion[k] = (x[k] - skins_[k].vertices.world(*b.q_prev2)).rowwise().norm();
+  }
+  const double reach = options_.margin + kMotionFactor * (motion[0].maxCoeff() + motion[1].maxCoeff()) +
+                       std::max(skins_[0].max_edge, skins_[1].max_edge);
+  if (!geometry::Aabb::of_points(x[0]).inflated(reach).intersects(geometry::Aabb::of_points(x[1]))) return;
+  collect_pairs(0, skins_[0], x[0], motion[0], skins_[1], x[1], motion[1], c.pairs);
+  collect_pairs(1, skins_[1], x[1], motion[1], skins_[0], x[0], motion[0], c.pairs);
+}
+
+bool SkinContactTerm::active(const StepContext& ctx) const {
+  return !static_cast<PairCache&>(*ctx.cache).pairs.empty();
+}
+
+double SkinContactTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
+  auto& c = static_cast<PairCache&>(*ctx.cache);
+  const Configuration* qs[2] = {&q, ctx.bound[1].q};
+  const DofLayout* layouts[2] = {&ctx.bound[0].layout, &ctx.bound[1].layout};
+  const double half_kappa = 0.5 * options_.pressure_stiffness;
+  const int n_local = layouts[1]->end();
+  const bool derivatives = grad || hess;
+  if (derivatives && c.row.size() != n_local) {
+    c.row = VecX::Zero(n_local);
+    c.mark.assign(n_local, 0);
+  }
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  double E = 0;
+  for (const Pair& p : c.pairs) {
+    const int from = p.side;
+    const double g = gap(p, qs);
+    if (!(g < 0)) continue;
+    const double k = half_kappa * p.area;
+    E += 0.5 * k * g * g;
+    if (!derivatives) continue;
+    // row = nᵀ (∂x/∂δ − ∂y/∂δ), over the DoFs the six vertices touch.
+    c.touched.clear();
+    for (int side = 0; side < 2; ++side) {
+      const Skin& s = skins_[side];
+      const int face = side == from ? p.face : p.other_face;
+      const Vec3& bary = side == from ? p.lambda : p.mu;
+      const double sign = side == from ? 1.0 : -1.0;
+      for (int i = 0; i < 3; ++i) {
+        if (bary[i] == 0) continue;
+        s.vertices.local_jacobian(s.faces(face, i), *qs[side], *layouts[side], J, cols);
+        for (int col = 0; col < int(cols.size()); ++col) {
+          const int d = cols[col];
+          if (!c.mark[d]) {
+            c.mark[d] = 1;
+            c.touched.push_back(d);
+          }
+          c.row[d] += sign * bary[i] * p.normal.dot(J.col(col));
+        }
+      }
+    }
+    for (int a : c.touched) {
+      if (grad) (*grad)[a] += k * g * c.row[a];
+      if (hess)
+        for (int b : c.touched) (*hess)(a, b) += k * c.row[a] * c.row[b];
+    }
+    for (int a : c.touched) {
+      c.row[a] = 0;
+      c.mark[a] = 0;
+    }
+  }
+  return E;
+}
+
+std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const Configuration& q) const {
+  const auto& c = static_cast<PairCache&>(*ctx.cache);
+  const Configuration* qs[2] = {&q, ctx.bound[1].q};
+  const double half_kappa = 0.5 * options_.pressure_stiffness;
+  Vec3 force = Vec3::Zero();
+  int active = 0;
+  double worst = 0, area = 0;
+  for (const Pair& p : c.pairs) {
+    const int from = p.side;
+    const double g = gap(p, qs);
+    if (!(g < 0)) continue;
+    // On the sample's body: −κ/2 a g n; a is that body on side 0, the other one on side 1.
+    const Vec3 on_sample = -half_kappa * p.area * g * p.normal;
+    force += from == 0 ? on_sample : Vec3(-on_sample);
+    ++active;
+    worst = std::max(worst, -g);
+    area += 0.5 * p.area;
+  }
+  return {{"force", "N", force},
+          {"active_samples", "", VecX::Constant(1, active)},
+          {"max_penetration", "m", VecX::Constant(1, worst)},
+          {"contact_area", "m^2", VecX::Constant(1, area)}};
+}
+
+}  // namespace sflsh
