@@ -446,6 +446,18 @@ TEST(CapsuleContact, GradientHessianAndMomentumBetweenTwoBodies) {
   EXPECT_LT(torque.norm(), 1e-12 * d.grad.norm());
 }
 
+/// Boxes a and b at rest, b shifted by `shift` along x, bound with their bone blocks only.
+std::vector<Bound> boxes_apart(const Avatar& a, const Avatar& b, double shift) {
+  Configuration qa, qb;
+  qa.bones.assign(24, Isometry::Identity());
+  qb.bones.assign(24, Isometry(Eigen::Translation3d(shift, 0, 0)));
+  qa.z = qb.z = VecX::Zero(0);
+  std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa}, {&b, body_layout(b, true), qb, qb, qb}};
+  for (Bound& bd : bodies) bd.layout.num_reduced = 0;
+  bodies[1].layout.base = bodies[0].layout.size();
+  return bodies;
+}
+
 TEST(CapsuleContact, NoEnergyAtAGapAndHalfKDepthSquaredInOverlap) {
   // Two rest-pose boxes side by side: parallel capsule axes (radius 3 cm,
   // same y range), so by hand the signed distance is |shift| − 6 cm.
@@ -453,13 +465,7 @@ TEST(CapsuleContact, NoEnergyAtAGapAndHalfKDepthSquaredInOverlap) {
   const double k = 1.0e4;
   const CapsuleContactTerm term(a, &b, {k, 2});
   for (double shift : {0.061, 0.0601, 0.055}) {
-    Configuration qa, qb;
-    qa.bones.assign(24, Isometry::Identity());
-    qb.bones.assign(24, Isometry(Eigen::Translation3d(shift, 0, 0)));
-    qa.z = qb.z = VecX::Zero(0);
-    std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa}, {&b, body_layout(b, true), qb, qb, qb}};
-    for (Bound& bd : bodies) bd.layout.num_reduced = 0;
-    bodies[1].layout.base = bodies[0].layout.size();
+    std::vector<Bound> bodies = boxes_apart(a, b, shift);
     StepContext ctx = bind_bodies(bodies, nullptr);
     const auto cache = begin_term_step(term, ctx);
     const Derivatives d = analytic(term, ctx, bodies);
@@ -477,13 +483,7 @@ TEST(CapsuleContact, CoresScaleEveryRadius) {
   const double k = 1.0e4;
   const CapsuleContactTerm term(a, &b, {k, 2, 0.5});
   for (const auto& [shift, depth] : {std::pair{0.05, 0.0}, std::pair{0.025, 0.005}}) {
-    Configuration qa, qb;
-    qa.bones.assign(24, Isometry::Identity());
-    qb.bones.assign(24, Isometry(Eigen::Translation3d(shift, 0, 0)));
-    qa.z = qb.z = VecX::Zero(0);
-    std::vector<Bound> bodies{{&a, body_layout(a, true), qa, qa, qa}, {&b, body_layout(b, true), qb, qb, qb}};
-    for (Bound& bd : bodies) bd.layout.num_reduced = 0;
-    bodies[1].layout.base = bodies[0].layout.size();
+    std::vector<Bound> bodies = boxes_apart(a, b, shift);
     StepContext ctx = bind_bodies(bodies, nullptr);
     const auto cache = begin_term_step(term, ctx);
     EXPECT_NEAR(analytic(term, ctx, bodies).E, 0.5 * k * depth * depth, 1e-12) << "shift " << shift;
