@@ -85,10 +85,13 @@ int PointGrid::nearest(const Vec3& x, double max_distance, double* distance) con
       if (found >= 0 && best <= (k - 1) * cell_) break;
       const Eigen::Vector3i a = (c.array() - k).max(lo_.array()), b = (c.array() + k).min(hi_.array());
       for (int z = a.z(); z <= b.z(); ++z)
-        for (int y = a.y(); y <= b.y(); ++y)
-          for (int xx = a.x(); xx <= b.x(); ++xx) {
-            const Eigen::Vector3i d = Eigen::Vector3i(xx, y, z) - c;
-            if (d.cwiseAbs().maxCoeff() != k) continue;  // an inner ring's cell
+        for (int y = a.y(); y <= b.y(); ++y) {
+          // Inside the ring's cube only its shell: every x on the z and y
+          // faces, else the two x faces.
+          const bool face = std::abs(z - c.z()) == k || std::abs(y - c.y()) == k;
+          const int step = face || k == 0 ? 1 : 2 * k;
+          for (int xx = face ? a.x() : c.x() - k; xx <= b.x(); xx += step) {
+            if (xx < a.x()) continue;
             const auto it = cells_.find(key(Eigen::Vector3i(xx, y, z)));
             if (it == cells_.end()) continue;
             for (int i = it->second.first; i < it->second.second; ++i) {
@@ -99,10 +102,26 @@ int PointGrid::nearest(const Vec3& x, double max_distance, double* distance) con
               }
             }
           }
+        }
     }
   }
   if (distance) *distance = found >= 0 ? best : std::numeric_limits<double>::infinity();
   return found;
+}
+
+bool PointGrid::occupied(const Aabb& box) const {
+  if (box.empty() || points_.rows() == 0) return false;
+  Eigen::Vector3i a = lo_, b = hi_;
+  for (int ax = 0; ax < 3; ++ax) {
+    if (std::isfinite(box.min[ax])) a[ax] = int(std::max<double>(lo_[ax], std::floor(box.min[ax] / cell_)));
+    if (std::isfinite(box.max[ax])) b[ax] = int(std::min<double>(hi_[ax], std::floor(box.max[ax] / cell_)));
+  }
+  if ((a.array() > b.array()).any()) return false;
+  for (int z = a.z(); z <= b.z(); ++z)
+    for (int y = a.y(); y <= b.y(); ++y)
+      for (int x = a.x(); x <= b.x(); ++x)
+        if (cells_.count(key(Eigen::Vector3i(x, y, z)))) return true;
+  return false;
 }
 
 std::vector<int> PointGrid::query(const Aabb& box) const {

@@ -78,6 +78,19 @@ TEST(PointGrid, NearestMatchesBruteForce) {
   EXPECT_GT(hits, 50);  // both outcomes exercised
   EXPECT_GT(misses, 50);
   EXPECT_EQ(geometry::PointGrid(Points(0, 3), 0.1).nearest(Vec3::Zero(), 1.0), -1);
+  // occupied(): false only where a box query finds nothing; true at every point.
+  const geometry::PointGrid coarse(p, 0.12);
+  int empty = 0;
+  for (int q = 0; q < 400; ++q) {
+    const Vec3 x(1.5 * u(rng), 1.5 * u(rng), 1.5 * u(rng));
+    const Aabb box = Aabb(x, x).inflated(reach(rng) / 4);
+    if (!coarse.occupied(box)) {
+      EXPECT_TRUE(grid.query(box).empty()) << "query " << q;
+      ++empty;
+    }
+  }
+  EXPECT_GT(empty, 50);
+  for (int i = 0; i < p.rows(); i += 97) EXPECT_TRUE(coarse.occupied(Aabb(p.row(i).transpose(), p.row(i).transpose())));
 }
 
 TEST(Aabb, ExtendInflateIntersectTransform) {

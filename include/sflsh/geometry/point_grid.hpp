@@ -32,6 +32,10 @@ class PointGrid {
   /// farther ring can hold a nearer point, so a query costs what lies
   /// between x and its nearest point.
   int nearest(const Vec3& x, double max_distance, double* distance = nullptr) const;
+  /// Whether some occupied cell overlaps `box`: false guarantees that query(box)
+  /// is empty (true does not guarantee a point inside). Costs the cells the
+  /// box overlaps, not their points: a cheap first test with a coarse grid.
+  bool occupied(const Aabb& box) const;
 
   int num_points() const { return int(points_.rows()); }
   int num_cells() const { return int(cells_.size()); }

@@ -90,8 +90,8 @@ void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_
   const double fastest_to = m_to.size() ? m_to.maxCoeff() : 0.0;
   auto reach = [&](double m) { return options_.margin + kMotionFactor * (m + fastest_to); };
   const double slack = to.max_edge;  // a surface point is within an edge of one of its face's vertices
-  const geometry::Aabb near_from =
-      geometry::Aabb::of_points(x_from).inflated(reach(m_from.size() ? m_from.maxCoeff() : 0.0) + slack);
+  const double max_reach = reach(m_from.size() ? m_from.maxCoeff() : 0.0) + slack;
+  const geometry::Aabb near_from = geometry::Aabb::of_points(x_from).inflated(max_reach);
   std::vector<int> to_index;
   for (int w = 0; w < int(x_to.rows()); ++w)
     if (near_from.contains(x_to.row(w).transpose())) to_index.push_back(w);
@@ -100,6 +100,8 @@ void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_
   for (size_t i = 0; i < to_index.size(); ++i) to_near.row(i) = x_to.row(to_index[i]);
   const geometry::PointGrid grid(to_near, 0.02);
   const geometry::Aabb near_to = geometry::Aabb::of_points(to_near);
+  // A coarse grid (cells of the largest reach) rules out most far vertices in a few lookups.
+  const geometry::PointGrid coarse(to_near, std::max(max_reach, 0.02));
 
   // This skin's faces with a vertex within reach of the other skin's nearest
   // vertex (margin plus kMotionFactor times the motion of both, plus an edge).
@@ -108,7 +110,8 @@ void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_
   for (int v = 0; v < int(x_from.rows()); ++v) {
     const Vec3 x = x_from.row(v).transpose();
     const double r = reach(m_from[v]) + slack;
-    if (!near_to.inflated(r).contains(x)) continue;
+    const geometry::Aabb box = geometry::Aabb(x, x).inflated(r);
+    if (!near_to.intersects(box) || !coarse.occupied(box)) continue;
     const int w = grid.nearest(x, r, &nearest_to[v]);
     if (w < 0 || nearest_to[v] > options_.margin + kMotionFactor * (m_from[v] + m_to[to_index[w]]) + slack) continue;
     for (int f : from.vertex_faces[v]) candidate[f] = 1;
