@@ -1,5 +1,6 @@
 #include "sflsh/scene/scene_run.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -13,6 +14,7 @@
 #include "sflsh/scene/scene_session.hpp"
 #include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/sim/momentum.hpp"
+#include "sflsh/sim/state_file.hpp"
 
 namespace sflsh {
 
@@ -56,55 +58,35 @@ std::string SceneContactStats::describe() const {
   return o.str();
 }
 
-SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& opt, SceneContactStats* stats) {
-  SceneSessionOptions so;
-  so.progress = opt.progress;
-  so.body_push_limit = opt.body_push_limit;
-  SceneSession session(sc, so);
-  const Simulator& sim = session.simulator();
-  const long steps = session.total_steps();
-  SimulationResult r = session.result_header();
-  session.record_frame(r, 0.0);
+namespace {
 
-  SceneContactStats st;
-  st.momentum_start = linear_momentum(sim.model(), sim.scene_state());
-  std::map<std::pair<std::string, int>, size_t> pair_index;
-  // Tools' anchors and couplings: reported in tool_steps, not as contact pairs.
-  std::set<int> tool_terms;
-  for (int i = 0; i < session.num_tools(); ++i) {
-    const CompiledTool& t = session.compiled_tool(i);
-    tool_terms.insert(t.anchor_terms.begin(), t.anchor_terms.end());
-    if (t.coupling_term >= 0) tool_terms.insert(t.coupling_term);
-  }
-  const double frame_dt = 1.0 / sc.output.fps;
-  double next_frame = frame_dt, ms_since_frame = 0;
-  int steps_since_frame = 0;
-  Progress progress("simulating " + r.motion, steps);
-  for (long k = 0; k < steps; ++k) {
-    if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
-    const StepReport* step_report = nullptr;
-    try {
-      step_report = &session.advance();
-    } catch (const NonFiniteError& e) {
-      // Keep the frames made so far, marked incomplete (no frame of this step).
-      r.incomplete = true;
-      r.stop_reason = e.what();
-      throw SimulationStopped(e.what(), std::move(r));
+/// Gathers SceneContactStats step by step from the terms' reports and the tools' states.
+class ContactStatsRecorder {
+ public:
+  explicit ContactStatsRecorder(const SceneSession& scene) : scene_(scene) {
+    const Simulator& sim = scene.simulator();
+    stats_.momentum_start = linear_momentum(sim.model(), sim.scene_state());
+    // Tools' anchors and couplings: reported in tool_steps, not as contact pairs.
+    for (int i = 0; i < scene.num_tools(); ++i) {
+      const CompiledTool& t = scene.compiled_tool(i);
+      tool_terms_.insert(t.anchor_terms.begin(), t.anchor_terms.end());
+      if (t.coupling_term >= 0) tool_terms_.insert(t.coupling_term);
     }
-    const StepReport& rep = *step_report;
-    const double t = (k + 1) * session.dt();
-    for (int i = 0; i < session.num_tools(); ++i) {
-      const SceneToolState& ts = session.tool_state(i);
-      st.tool_steps.push_back({t, session.tool_name(i), ts.force, ts.anchors, ts.max_stretch});
+  }
+
+  void add_step(double t, const StepReport& rep) {
+    for (int i = 0; i < scene_.num_tools(); ++i) {
+      const SceneToolState& ts = scene_.tool_state(i);
+      stats_.tool_steps.push_back({t, scene_.tool_name(i), ts.force, ts.anchors, ts.max_stretch});
     }
     // Contact figures from the terms' reports.
-    for (SceneContactStats::Pair& p : st.pairs) p.last_force.setZero();  // inactive terms report nothing
+    for (SceneContactStats::Pair& p : stats_.pairs) p.last_force.setZero();  // inactive terms report nothing
     for (const TermQuantityReport& q : rep.quantities) {
-      if (tool_terms.count(q.term_index)) continue;
+      if (tool_terms_.count(q.term_index)) continue;
       const auto key = std::make_pair(q.term, q.body);
-      auto [it, fresh] = pair_index.try_emplace(key, st.pairs.size());
-      if (fresh) st.pairs.push_back({q.term, sim.model().bodies()[q.body].name});
-      SceneContactStats::Pair& p = st.pairs[it->second];
+      auto [it, fresh] = pair_index_.try_emplace(key, stats_.pairs.size());
+      if (fresh) stats_.pairs.push_back({q.term, scene_.simulator().model().bodies()[q.body].name});
+      SceneContactStats::Pair& p = stats_.pairs[it->second];
       if (q.name == "max_penetration" || q.name == "max_overlap") {
         p.max_penetration = std::max(p.max_penetration, q.value[0]);
         if (q.value[0] > 0) ++p.active_steps;
@@ -113,23 +95,111 @@ SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& op
         p.max_force = std::max(p.max_force, p.last_force.norm());
       }
     }
-    r.add_step(t, rep);
-    ms_since_frame += rep.ms_total;
-    ++steps_since_frame;
-    if (t + 1e-9 >= next_frame) {
-      session.record_frame(r, ms_since_frame / steps_since_frame);
-      next_frame += frame_dt;
-      ms_since_frame = 0;
-      steps_since_frame = 0;
+  }
+
+  SceneContactStats finish() {
+    stats_.tool_events = scene_.tool_events();
+    const Simulator& sim = scene_.simulator();
+    stats_.momentum_end = linear_momentum(sim.model(), sim.scene_state());
+    return std::move(stats_);
+  }
+
+ private:
+  const SceneSession& scene_;
+  SceneContactStats stats_;
+  std::map<std::pair<std::string, int>, size_t> pair_index_;
+  std::set<int> tool_terms_;
+};
+
+/// Makes the output frames: every one to on_frame, kept in the result
+/// (keep_frames), counted, with the first body's pelvis against its motion's.
+class FrameRecorder {
+ public:
+  FrameRecorder(const SceneSession& scene, const SceneRunOptions& options, SimulationResult& result)
+      : scene_(scene), options_(options), r_(result), frame_dt_(1.0 / scene.scene().output.fps) {
+    const double t = scene.simulator().time();
+    next_frame_ = (std::floor(t / frame_dt_ + 1e-9) + 1) * frame_dt_;
+    record(0.0);
+  }
+
+  /// After a step ending at time t taking `ms`: a frame when one is due.
+  void add_step(double t, double ms) {
+    ms_since_frame_ += ms;
+    ++steps_since_frame_;
+    if (t + 1e-9 < next_frame_) return;
+    record(ms_since_frame_ / steps_since_frame_);
+    next_frame_ += frame_dt_;
+    ms_since_frame_ = 0;
+    steps_since_frame_ = 0;
+  }
+
+ private:
+  void record(double ms) {
+    FrameData fr = scene_.frame(ms);
+    const double pelvis_error = (fr.joints.row(0).transpose() - fr.target_pelvis).norm();
+    pelvis_error_sum_ += pelvis_error;
+    r_.pelvis_error_max = std::max(r_.pelvis_error_max, pelvis_error);
+    ++r_.pelvis_frames;
+    r_.pelvis_error_mean = pelvis_error_sum_ / r_.pelvis_frames;
+    ++r_.num_frames;
+    r_.tool_events = scene_.tool_events();
+    if (options_.on_frame) options_.on_frame(fr);
+    if (options_.keep_frames) r_.add_frame(std::move(fr));
+  }
+
+  const SceneSession& scene_;
+  const SceneRunOptions& options_;
+  SimulationResult& r_;
+  const double frame_dt_;
+  double next_frame_ = 0, ms_since_frame_ = 0, pelvis_error_sum_ = 0;
+  int steps_since_frame_ = 0;
+};
+
+}  // namespace
+
+SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& opt, SceneContactStats* stats) {
+  if (!opt.resume.empty()) scene.resume(read_state(opt.resume, scene.simulator().model()), opt.resume);
+  const long steps = scene.total_steps();
+  SimulationResult r = scene.result_header();
+  FrameRecorder frames(scene, opt, r);
+  ContactStatsRecorder contact(scene);
+  Progress progress("simulating " + r.motion, steps);
+  while (scene.steps_done() < steps) {
+    const long k = scene.steps_done();
+    if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
+    const StepReport* step_report = nullptr;
+    try {
+      step_report = &scene.advance();
+    } catch (const NonFiniteError& e) {
+      // Keep the frames made so far, marked incomplete (no frame of this step).
+      if (opt.progress) progress.finish();
+      r.incomplete = true;
+      r.stop_reason = e.what();
+      throw SimulationStopped(e.what(), std::move(r));
     }
+    const StepReport& rep = *step_report;
+    const double t = (k + 1) * scene.dt();
+    contact.add_step(t, rep);
+    r.add_step(t, rep);
+    if (opt.on_step) opt.on_step(scene.simulator(), rep);
+    frames.add_step(t, rep.ms_total);
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();
-  st.tool_events = session.tool_events();
-  r.tool_events = session.tool_events();  // also those after the last frame
-  st.momentum_end = linear_momentum(sim.model(), sim.scene_state());
-  if (stats) *stats = std::move(st);
+  r.tool_events = scene.tool_events();  // also those after the last frame
+  if (stats) *stats = contact.finish();
+  if (!opt.checkpoint.empty())
+    write_state(opt.checkpoint, scene.simulator().model(), scene.simulator().scene_state());
   return r;
+}
+
+SimulationResult run_scene(const SceneDescription& sc, const SceneRunOptions& opt, SceneContactStats* stats) {
+  SceneSessionOptions so;
+  so.progress = opt.progress;
+  so.body_push_limit = opt.body_push_limit;
+  so.inject_nan_at_step = opt.inject_nan_at_step;
+  SceneSession scene(sc, so);
+  return run_scene(scene, opt, stats);
 }
 
 }  // namespace sflsh

@@ -6,6 +6,7 @@
 
 #include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
+#include "sflsh/sim/skeleton_pose.hpp"
 #include "scene/scene_session_impl.hpp"
 
 namespace sflsh {
@@ -19,14 +20,29 @@ std::string file_name(const std::string& path) {
 
 }  // namespace
 
+std::vector<Isometry> SceneSession::Impl::object_poses(double t) const {
+  std::vector<Isometry> poses;
+  for (const CompiledObject& o : compiled.objects) poses.push_back(object_pose(o, t));
+  for (const ToolDriver& tool : tools)
+    if (tool.tool().desc->has_shape) poses.push_back(tool.drawn_pose(t));
+  for (const ToolDriver& tool : tools)
+    for (const CompiledJaw& j : tool.tool().jaws) poses.push_back(tool.jaw_pose(j));
+  return poses;
+}
+
 SimulationResult SceneSession::result_header() const {
   const Impl& m = *impl_;
   const CompiledScene& cs = m.compiled;
   SimulationResult r;
-  r.motion = m.sc.path.empty() ? std::string("scene") : file_name(m.sc.path);
+  r.motion = cs.one_avatar ? cs.name : m.sc.path.empty() ? std::string("scene") : file_name(m.sc.path);
   r.dt = cs.h;
   r.bones_dynamic = cs.bodies[0].desc->bones_dynamic;
   r.newton_iters = m.sc.solver.newton_iterations;
+  if (cs.one_avatar) {
+    r.faces = cs.bodies[0].avatar->surface_faces;
+    r.surface_rest = cs.bodies[0].avatar->surface_rest;
+    return r;
+  }
   r.body_vertex_offsets.push_back(0);
   std::string names;
   int V = 0, F = 0;
@@ -63,64 +79,58 @@ SimulationResult SceneSession::result_header() const {
   return r;
 }
 
-std::vector<Isometry> SceneSession::object_poses() const {
-  const Impl& m = *impl_;
-  const double t = m.sim->time();
-  std::vector<Isometry> poses;
-  for (const CompiledObject& o : m.compiled.objects) poses.push_back(m.object_pose(o, t));
-  for (const ToolDriver& tool : m.tools)
-    if (tool.tool().desc->has_shape) poses.push_back(tool.drawn_pose(t));
-  for (const ToolDriver& tool : m.tools)
-    for (const CompiledJaw& j : tool.tool().jaws) poses.push_back(tool.jaw_pose(j));
-  return poses;
-}
+std::vector<Isometry> SceneSession::object_poses() const { return impl_->object_poses(impl_->sim->time()); }
 
-void SceneSession::record_frame(SimulationResult& r, double ms) const {
+FrameData SceneSession::frame(double ms) const {
   const Impl& m = *impl_;
   const CompiledScene& cs = m.compiled;
   const Simulator& sim = *m.sim;
-  const double t = m.k * cs.h;
-  const int V = r.body_vertex_offsets.back();
-  Points positions(V, 3), displacement(V, 3), joints(24 * int(cs.bodies.size()), 3);
-  VecX reduced(0);
+  FrameData fr;
+  // The run's first frame has the state's own time (a checkpoint's may differ
+  // from k·h in the last bits), later ones the step's k·h.
+  fr.time = m.k == m.first_k ? sim.time() : m.k * cs.h;
+  fr.step_ms = ms;
+  int V = 0;
+  for (const CompiledBody& b : cs.bodies) V += int(b.avatar->surface_rest.rows());
+  fr.positions.resize(V, 3);
+  fr.displacement.resize(V, 3);
+  fr.joints.resize(24 * int(cs.bodies.size()), 3);
+  fr.reduced.resize(0);
+  int v0 = 0;
   for (size_t i = 0; i < cs.bodies.size(); ++i) {
-    const int v0 = r.body_vertex_offsets[i], n = r.body_vertex_offsets[i + 1] - v0, k = cs.bodies[i].model_index;
-    positions.middleRows(v0, n) = sim.posed_surface(k);
-    displacement.middleRows(v0, n) = sim.soft_displacement(k);
-    // The contact patches' dents (unposed), carried to the world by the skin's blend of bone rotations.
     const Avatar& a = *cs.bodies[i].avatar;
+    const int n = int(a.surface_rest.rows()), k = cs.bodies[i].model_index;
+    fr.positions.middleRows(v0, n) = sim.posed_surface(k);
+    fr.displacement.middleRows(v0, n) = sim.soft_displacement(k);
+    // The contact patches' dents (unposed), carried to the world by the skin's blend of bone rotations.
     const Points dent = patch_surface_displacement(a, m.report, k);
     for (int v = 0; v < n; ++v) {
       if (dent.row(v).isZero()) continue;
       const Mat3 A = skinning_rotation_blend(a.surface_weights.row(v), sim.state(k).bones);
-      displacement.row(v0 + v) += dent.row(v);
-      positions.row(v0 + v) += (A * dent.row(v).transpose()).transpose();
+      fr.displacement.row(v0 + v) += dent.row(v);
+      fr.positions.row(v0 + v) += (A * dent.row(v).transpose()).transpose();
     }
-    joints.middleRows(24 * int(i), 24) = sim.joints(k);
+    fr.joints.middleRows(24 * int(i), 24) = sim.joints(k);
     const VecX& z = sim.state(k).z;
-    VecX grown(reduced.size() + z.size());
-    grown << reduced, z;
-    reduced = std::move(grown);
+    VecX grown(fr.reduced.size() + z.size());
+    grown << fr.reduced, z;
+    fr.reduced = std::move(grown);
+    v0 += n;
   }
+  // The first body's motion pelvis: G_0 J̄_0 of its target bones, as /frames/joints puts the simulated one.
   const CompiledBody& b0 = cs.bodies[0];
-  r.frame_time.push_back(t);
-  r.frame_step_ms.push_back(ms);
-  r.frame_positions.push_back(std::move(positions));
-  r.frame_displacement.push_back(std::move(displacement));
-  r.frame_joints.push_back(std::move(joints));
-  r.frame_reduced.push_back(std::move(reduced));
-  r.frame_target_pelvis.push_back(b0.target_pose(t).translation + b0.avatar->joints_rest.row(0).transpose());
-  for (size_t i = 0; i < cs.objects.size(); ++i) r.objects[i].poses.push_back(m.object_pose(cs.objects[i], t));
-  size_t next = cs.objects.size();
-  for (const ToolDriver& tool : m.tools)
-    if (tool.tool().desc->has_shape) r.objects[next++].poses.push_back(tool.drawn_pose(t));
-  for (const ToolDriver& tool : m.tools)
-    for (const CompiledJaw& j : tool.tool().jaws) r.objects[next++].poses.push_back(tool.jaw_pose(j));
-  for (size_t i = 0; i < m.tools.size(); ++i) {
-    const SceneToolState& ts = m.tools[i].state();
-    r.tools[i].frames.push_back({m.tools[i].drawn_pose(t), ts.device.closure, ts.force, ts.torque});
+  fr.target_pelvis = target_bones(*b0.avatar, b0.target_pose(fr.time))[0] * Vec3(b0.avatar->joints_rest.row(0).transpose());
+  fr.object_poses = m.object_poses(fr.time);
+  for (const ToolDriver& tool : m.tools) {
+    const SceneToolState& ts = tool.state();
+    fr.tools.push_back({tool.drawn_pose(fr.time), ts.device.closure, ts.force, ts.torque});
   }
-  r.tool_events = m.events;
+  return fr;
+}
+
+void SceneSession::record_frame(SimulationResult& r, double ms) const {
+  r.add_frame(frame(ms));
+  r.tool_events = impl_->events;
   ++r.num_frames;
 }
 
