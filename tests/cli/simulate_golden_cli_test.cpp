@@ -10,7 +10,6 @@
 //   SFLSH_PRINT_GOLDEN=1 build/test_cli --gtest_filter='SimulateGoldenCli.*'
 #include <gtest/gtest.h>
 
-#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -18,38 +17,13 @@
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/scene/result_file.hpp"
 #include "sim/skeleton_fixture.hpp"
-#include "sim/synthetic_avatar.hpp"
 #include "test_support.hpp"
 
 using namespace sflsh;
 
 namespace {
 
-/// FNV-1a over the bytes of every value hashed: any change of a bit shows.
-class BitHash {
- public:
-  void add(double x) { add_bytes(&x, sizeof x); }
-  void add(long x) { add_bytes(&x, sizeof x); }
-  template <typename M>
-  void add_matrix(const M& m) {
-    add(long(m.rows()));
-    add(long(m.cols()));
-    for (Eigen::Index j = 0; j < m.cols(); ++j)
-      for (Eigen::Index i = 0; i < m.rows(); ++i) add(double(m(i, j)));
-  }
-  std::string hex() const {
-    char s[17];
-    std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(h_));
-    return s;
-  }
-
- private:
-  void add_bytes(const void* p, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 1099511628211ull;
-  }
-  std::uint64_t h_ = 1469598103934665603ull;
-};
+using test::BitHash;
 
 struct Golden {
   std::string state_hash;   ///< frames: positions, displacement, joints, z, times
@@ -82,14 +56,8 @@ Golden fingerprint(const SimulationResult& r, double* z_sum) {
 
 /// Synthetic box (8 hat handles, sampled cubature) carrying the T-pose skeleton.
 std::string write_golden_avatar(const test::TempDir& dir) {
-  test::SyntheticAvatarOptions so;
-  so.handles = 8;
-  so.all_tets = false;
-  so.samples = 12;
-  Avatar a = test::make_synthetic_avatar(so);
-  a.joints_rest = test::make_tpose_skeleton().joints_rest;
   const std::string path = dir.file("a.h5");
-  write_avatar(a, path);
+  write_avatar(*test::make_tpose_box(8, 12), path);
   return path;
 }
 
