@@ -1,13 +1,14 @@
-// What a SceneSession writes to a SimulationResult: the constant header (every
-// body's skin, the objects' and tools' surfaces, the tools' names) and one
-// frame per call (skins, joints, object poses, every tool's pose, closure,
-// force and torque, and the grasp and release events so far).
+// What a scene shows of itself (SceneSession): the result's constant header
+// (every body's skin, the objects' and tools' surfaces, the tools' names), its
+// output frames (skins, joints, object poses, every tool's pose, closure,
+// force and torque, and the grasp and release events so far) and the bodies'
+// current surfaces and joints.
 #include "sflsh/scene/scene_session.hpp"
 
 #include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/skeleton_pose.hpp"
-#include "scene/scene_session_impl.hpp"
+#include "scene/scene_run_state.hpp"
 
 namespace sflsh {
 namespace {
@@ -132,6 +133,19 @@ void SceneSession::record_frame(SimulationResult& r, double ms) const {
   r.add_frame(frame(ms));
   r.tool_events = impl_->events;
   ++r.num_frames;
+}
+
+int SceneSession::num_bodies() const { return int(impl_->compiled.bodies.size()); }
+const std::string& SceneSession::body_name(int body) const { return impl_->compiled.bodies.at(body).desc->name; }
+const Avatar& SceneSession::avatar(int body) const { return *impl_->compiled.bodies.at(body).avatar; }
+int SceneSession::body_model_index(int body) const { return impl_->compiled.bodies.at(body).model_index; }
+Points SceneSession::body_surface(int body) const { return impl_->sim->posed_surface(body_model_index(body)); }
+Points SceneSession::body_displacement(int body) const {
+  return impl_->sim->soft_displacement(body_model_index(body));
+}
+Points SceneSession::body_joints(int body) const { return impl_->sim->joints(body_model_index(body)); }
+BodyPose SceneSession::body_target_pose(int body, double t) const {
+  return impl_->compiled.bodies.at(body).target_pose(t);
 }
 
 }  // namespace sflsh

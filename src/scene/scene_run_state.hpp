@@ -1,7 +1,7 @@
 #pragma once
-// SceneSession's state, shared by its two source files: scene_session.cpp
-// (building, stepping, tools, stiffness) and scene_session_result.cpp (what
-// it writes to a result).
+// SceneSession's state, shared by the files that implement it: scene_run.cpp
+// (building, stepping, stiffness, resuming), scene_frames.cpp (the result's
+// header and frames, the bodies' surfaces) and tool_driver.cpp (its tools).
 #include <memory>
 #include <vector>
 
