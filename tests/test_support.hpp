@@ -2,13 +2,57 @@
 // Helpers shared by the test executables.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <initializer_list>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "sflsh/core/error.hpp"
+#include "sflsh/core/types.hpp"
 
 namespace sflsh::test {
+
+/// FNV-1a over the bytes of every value added: a golden test's fingerprint,
+/// in which any change of a bit shows.
+class BitHash {
+ public:
+  void add(double x) { add_bytes(&x, sizeof x); }
+  void add(int x) { add_bytes(&x, sizeof x); }
+  void add(long x) { add_bytes(&x, sizeof x); }
+  void add(const Eigen::Isometry3d& T) {
+    for (int i = 0; i < 16; ++i) add(T.matrix().data()[i]);
+  }
+  void add(const VecX& v) {
+    add(int(v.size()));
+    for (Eigen::Index i = 0; i < v.size(); ++i) add(v[i]);
+  }
+  void add(const Vec3& v) {
+    for (int i = 0; i < 3; ++i) add(v[i]);
+  }
+  /// A matrix: its shape (as longs), then its values column by column.
+  template <typename M>
+  void add_matrix(const M& m) {
+    add(long(m.rows()));
+    add(long(m.cols()));
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      for (Eigen::Index i = 0; i < m.rows(); ++i) add(double(m(i, j)));
+  }
+  std::string hex() const {
+    char s[17];
+    std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(h_));
+    return s;
+  }
+
+ private:
+  void add_bytes(const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 1099511628211ull;
+  }
+  std::uint64_t h_ = 1469598103934665603ull;
+};
 
 /// A fresh, empty temporary folder for this test (removed at exit of the test).
 class TempDir {

@@ -18,6 +18,7 @@
 #include "sflsh/io/atomic_output.hpp"
 #include "sflsh/motion/load_motion.hpp"
 #include "sflsh/scene/material_file.hpp"
+#include "sflsh/scene/yaml_document.hpp"
 
 namespace sflsh::cli {
 namespace {
@@ -99,25 +100,19 @@ MaterialFitOptions fit_options(const FitArgs& a) {
 void run_dataset(const FitArgs& a) {
   require(!a.out.empty(), "fit --dataset: give --out (the map file)");
   io::check_output_file(a.out, "--out");
-  require(std::filesystem::exists(a.dataset), a.dataset, ": dataset file not found");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(a.dataset);
-  } catch (const YAML::Exception& e) {
-    fail(a.dataset, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
-  }
+  const YAML::Node root = load_yaml_file(a.dataset, "dataset file");
   require(root.IsMap() && root["subjects"] && root["subjects"].IsSequence(), a.dataset,
           ": expected 'subjects:' with a list of {avatar, observed[, motion]}");
   const std::filesystem::path dir = std::filesystem::path(a.dataset).parent_path();
   auto path_of = [&](const YAML::Node& n, const char* key) {
-    require(n[key] && n[key].IsScalar(), a.dataset, ":", n.Mark().line + 1, ": subject needs '", key, "'");
+    require(n[key] && n[key].IsScalar(), yaml_where(a.dataset, n), ": subject needs '", key, "'");
     const std::filesystem::path p(n[key].as<std::string>());
     return (p.is_absolute() ? p : dir / p).string();
   };
   std::vector<FitSubject> subjects;
   unsigned seed = a.seed;
   for (const YAML::Node& n : root["subjects"]) {
-    require(n.IsMap(), a.dataset, ":", n.Mark().line + 1, ": each subject is a map {avatar, observed[, motion]}");
+    require(n.IsMap(), yaml_where(a.dataset, n), ": each subject is a map {avatar, observed[, motion]}");
     const std::string motion = n["motion"] ? n["motion"].as<std::string>() : a.motion;
     LoadedSubject s = load_subject(a, path_of(n, "avatar"), path_of(n, "observed"), motion, seed++);
     subjects.push_back({path_of(n, "observed"), s.avatar, std::move(s.bones), std::move(s.steps), std::move(s.obs.positions)});

@@ -231,10 +231,10 @@ void validate_avatar(const Avatar& a, const std::string& where) {
   require(a.tet_region.size() == T && a.tet_region.minCoeff() >= 0 && a.tet_region.maxCoeff() < R, where,
           ": /tet/region must hold ", T, " indices in [0, ", R, ")");
   require(a.tet_frames.rows() == T && a.tet_frames.cols() == 9, where, ": /tet/frames must be (", T, ", 9)");
-  for (const auto& m : a.materials)
-    require(m.young_along > 0 && m.young_through > 0 && m.young_around > 0 && m.poisson > -1 && m.poisson < 0.5 &&
-                m.fung_c > 0 && m.density > 0,
-            where, ": /material/parameters of region '", m.name, "' are out of range");
+  for (const auto& m : a.materials) {
+    const std::string problem = m.range_problem();
+    require(problem.empty(), where, ": /material/parameters of region '", m.name, "' are out of range: ", problem);
+  }
   require(a.W.rows() == N && a.W.cols() == K, where, ": /basis weights must be (", N, ", ", K, ")");
   for (const Cubature* c : {&a.elastic, &a.inertia}) {
     const char* name = c == &a.elastic ? "/cubature/elastic" : "/cubature/inertia";

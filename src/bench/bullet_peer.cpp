@@ -19,10 +19,8 @@
 namespace sflsh {
 
 LameParameters isotropic_equivalent(const RegionMaterial& m) {
+  m.require_in_range();
   const double nu = m.poisson;
-  require(nu > -1.0 && nu < 0.5, "material '", m.name, "': poisson = ", nu, ", expected in (-1, 0.5)");
-  require(m.young_along > 0 && m.young_through > 0 && m.young_around > 0, "material '", m.name,
-          "': Young's moduli must be > 0");
   const double E[3] = {m.young_along, m.young_through, m.young_around};
   const double a = 1.0 / (1 + nu), b = nu / ((1 + nu) * (1 - 2 * nu));
   const double diag = (a + b) * (E[0] + E[1] + E[2]);                                               // Σ C_ii

@@ -389,10 +389,7 @@ std::vector<ContactBenchRow> run_contact_benchmark(const ContactBenchOptions& in
 }
 
 void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std::string& path) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(path, ": cannot write");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << "scene,handles,dt,steps,rel_err,dent_full_mm,dent_reduced_mm,dent_ratio,force_full_n,force_reduced_n,"
          "active_samples,active_samples_full,us_per_sample_iter,ms_contact,ms_no_contact,step_ratio,ms_full\n";
     char buf[512];
@@ -403,9 +400,7 @@ void write_contact_bench_csv(const std::vector<ContactBenchRow>& rows, const std
                     r.us_per_sample_iter, r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
       f << buf;
     }
-    if (!f) fail(path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::string& csv_path,
@@ -415,10 +410,7 @@ void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::str
     if (r.scene == "probe") probe.push_back(&r);
   require(!probe.empty(), "bench-contact: no probe rows to plot");
   const ContactBenchRow& first = *probe[0];
-  io::AtomicOutput out(csv_path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(csv_path, ": cannot write");
+  io::write_text_file(csv_path, [&](std::ostream& f) {
     f << "depth_mm,full_n";
     for (const auto* r : probe) f << ",K" << r->handles << "_n";
     f << "\n";
@@ -427,9 +419,7 @@ void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::str
       for (const auto* r : probe) f << "," << r->curve_force_reduced_n.at(i);
       f << "\n";
     }
-    if (!f) fail(csv_path, ": write failed");
-  }
-  out.commit();
+  });
   // The loading ramp only (up to the deepest point), where depth increases.
   size_t n = 0;
   while (n + 1 < first.curve_depth_mm.size() && first.curve_depth_mm[n + 1] > first.curve_depth_mm[n]) ++n;
@@ -448,10 +438,7 @@ void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::str
 
 void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
                                   const std::string& heading) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(path, ": cannot write");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << heading << "\n\n| scene | K | dt (s) | rel_err | dent full (mm) | dent reduced (mm) | dent ratio | peak force "
                     "full / reduced (N) | active samples full / reduced | µs / sample / iter | ms/step contact | ms/step no contact "
                     "| ratio | full FEM ms/step |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -480,9 +467,7 @@ void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, cons
                     r.max_patch_nodes);
       f << buf;
     }
-    if (!f) fail(path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 }  // namespace sflsh

@@ -12,6 +12,7 @@
 #include "sflsh/core/percentile.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/scene/torture_motion.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh {
 
@@ -185,15 +186,12 @@ StressReport run_stress(std::shared_ptr<const Avatar> avatar, const StressOption
 }
 
 void write_stress_csv(const StressReport& r, const std::string& path) {
-  std::ofstream f(path + ".partial");
-  if (!f) fail(path, ": cannot write");
-  f << "t_end,peak_soft_mm,max_elastic_J,min_det,damped,rejected,ms_median\n";
-  for (const StressWindow& w : r.windows)
-    f << w.t_end << ',' << w.peak_soft_mm << ',' << w.max_elastic_J << ',' << w.min_det << ',' << w.damped << ','
-      << w.rejected << ',' << w.ms_median << '\n';
-  if (!f) fail(path, ": write failed");
-  f.close();
-  std::rename((path + ".partial").c_str(), path.c_str());
+  io::write_text_file(path, [&](std::ostream& f) {
+    f << "t_end,peak_soft_mm,max_elastic_J,min_det,damped,rejected,ms_median\n";
+    for (const StressWindow& w : r.windows)
+      f << w.t_end << ',' << w.peak_soft_mm << ',' << w.max_elastic_J << ',' << w.min_det << ',' << w.damped << ','
+        << w.rejected << ',' << w.ms_median << '\n';
+  });
 }
 
 void write_stress_plot_svg(const StressReport& r, const std::string& path, const std::string& title) {
@@ -201,44 +199,42 @@ void write_stress_plot_svg(const StressReport& r, const std::string& path, const
   const double W = 900, panel = 150, L = 90, R = 30, T = 40, gap = 30;
   const double H = T + 3 * panel + 2 * gap + 50;
   const double t1 = r.windows.empty() ? 1.0 : r.windows.back().t_end;
-  std::ofstream f(path + ".partial");
-  if (!f) fail(path, ": cannot write");
-  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
-    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n"
-    << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
-  struct Series {
-    const char* name;
-    double StressWindow::*field;
-    const char* color;
-  };
-  const Series series[3] = {{"peak soft displacement (mm)", &StressWindow::peak_soft_mm, "#1f77b4"},
-                            {"max elastic energy (J)", &StressWindow::max_elastic_J, "#ff7f0e"},
-                            {"min det F over cubature samples", &StressWindow::min_det, "#2ca02c"}};
-  for (int p = 0; p < 3; ++p) {
-    const double y0 = T + p * (panel + gap);
-    double lo = 0, hi = 0;
-    for (const StressWindow& w : r.windows) hi = std::max(hi, w.*(series[p].field));
-    if (p == 2) {
-      lo = hi;
-      for (const StressWindow& w : r.windows) lo = std::min(lo, w.*(series[p].field));
-      lo = std::min(lo, 0.0);
-      hi = std::max(hi, 1.0);
+  io::write_text_file(path, [&](std::ostream& f) {
+    f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
+      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n"
+      << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
+    struct Series {
+      const char* name;
+      double StressWindow::*field;
+      const char* color;
+    };
+    const Series series[3] = {{"peak soft displacement (mm)", &StressWindow::peak_soft_mm, "#1f77b4"},
+                              {"max elastic energy (J)", &StressWindow::max_elastic_J, "#ff7f0e"},
+                              {"min det F over cubature samples", &StressWindow::min_det, "#2ca02c"}};
+    for (int p = 0; p < 3; ++p) {
+      const double y0 = T + p * (panel + gap);
+      double lo = 0, hi = 0;
+      for (const StressWindow& w : r.windows) hi = std::max(hi, w.*(series[p].field));
+      if (p == 2) {
+        lo = hi;
+        for (const StressWindow& w : r.windows) lo = std::min(lo, w.*(series[p].field));
+        lo = std::min(lo, 0.0);
+        hi = std::max(hi, 1.0);
+      }
+      if (hi <= lo) hi = lo + 1;
+      auto X = [&](double t) { return L + t / t1 * (W - L - R); };
+      auto Y = [&](double v) { return y0 + panel - (v - lo) / (hi - lo) * panel; };
+      f << "<rect x='" << L << "' y='" << y0 << "' width='" << W - L - R << "' height='" << panel
+        << "' fill='none' stroke='black'/>\n<text x='" << L + 6 << "' y='" << y0 + 14 << "'>" << series[p].name
+        << "</text>\n<text x='" << L - 6 << "' y='" << y0 + 12 << "' text-anchor='end'>" << hi << "</text>\n<text x='"
+        << L - 6 << "' y='" << y0 + panel << "' text-anchor='end'>" << lo << "</text>\n<polyline fill='none' stroke='"
+        << series[p].color << "' stroke-width='1.5' points='";
+      for (const StressWindow& w : r.windows) f << X(w.t_end) << ',' << Y(w.*(series[p].field)) << ' ';
+      f << "'/>\n";
     }
-    if (hi <= lo) hi = lo + 1;
-    auto X = [&](double t) { return L + t / t1 * (W - L - R); };
-    auto Y = [&](double v) { return y0 + panel - (v - lo) / (hi - lo) * panel; };
-    f << "<rect x='" << L << "' y='" << y0 << "' width='" << W - L - R << "' height='" << panel
-      << "' fill='none' stroke='black'/>\n<text x='" << L + 6 << "' y='" << y0 + 14 << "'>" << series[p].name
-      << "</text>\n<text x='" << L - 6 << "' y='" << y0 + 12 << "' text-anchor='end'>" << hi << "</text>\n<text x='"
-      << L - 6 << "' y='" << y0 + panel << "' text-anchor='end'>" << lo << "</text>\n<polyline fill='none' stroke='"
-      << series[p].color << "' stroke-width='1.5' points='";
-    for (const StressWindow& w : r.windows) f << X(w.t_end) << ',' << Y(w.*(series[p].field)) << ' ';
-    f << "'/>\n";
-  }
-  f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 12 << "' text-anchor='middle'>simulated time (s), 0 to " << t1
-    << "</text>\n</svg>\n";
-  f.close();
-  std::rename((path + ".partial").c_str(), path.c_str());
+    f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 12 << "' text-anchor='middle'>simulated time (s), 0 to " << t1
+      << "</text>\n</svg>\n";
+  });
 }
 
 }  // namespace sflsh

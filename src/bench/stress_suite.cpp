@@ -288,10 +288,7 @@ std::vector<StressCaseResult> run_stress_suite(std::shared_ptr<const Avatar> ava
 }
 
 void write_stress_suite_csv(const std::vector<StressCaseResult>& results, const std::string& path) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(path, ": cannot write");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << "case,status,dt,steps,nan,rejected,damped,min_det,peak_soft_mm,pelvis_max_mm,pelvis_mean_mm,ms_median,"
          "max_penetration_mm,peak_soft_early_mm,peak_soft_late_mm,setup,message\n";
     for (const StressCaseResult& c : results) {
@@ -304,17 +301,12 @@ void write_stress_suite_csv(const std::vector<StressCaseResult>& results, const 
         << (ran ? fmt(c.peak_soft_mm_early, 2) : "") << ',' << (ran ? fmt(c.peak_soft_mm_late, 2) : "") << ",\""
         << c.setup << "\",\"" << c.message << "\"\n";
     }
-    if (!f) fail(path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 void write_stress_suite_markdown(const std::vector<StressCaseResult>& results, const std::string& path,
                                  const std::string& command) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(path, ": cannot write");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << "# Stress suite\n\n`" << command << "`\n\n"
       << "| case | setup | steps | NaN | rejected | damped | min det F | peak soft (mm) | pelvis max / mean (mm) | "
          "median step (ms) | max penetration (mm) | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -329,9 +321,7 @@ void write_stress_suite_markdown(const std::vector<StressCaseResult>& results, c
         << fmt(c.ms_median, 2) << " | " << (c.max_penetration_mm >= 0 ? fmt(c.max_penetration_mm, 2) : "–") << " | "
         << c.status << (c.message.empty() ? "" : ": " + c.message) << " |\n";
     }
-    if (!f) fail(path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 void write_stress_suite_svg(const std::vector<StressCaseResult>& results, const std::string& path) {

@@ -48,14 +48,9 @@ Drive make_drive(const Avatar& avatar, const MotionClip& motion, int avatars, lo
 }
 
 void write_text(const std::string& path, const std::string& text) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    require(bool(f), path, ": cannot open for writing");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << text;
-    require(bool(f), path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 std::string table(const ThroughputReport& r) {

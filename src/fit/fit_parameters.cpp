@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/sim/elastic_sensitivity.hpp"
 
 namespace sflsh {
 namespace {
@@ -117,9 +118,10 @@ std::vector<RegionMaterial> FitParameters::materials(const std::vector<RegionMat
     const RegionMaterial& b = base.at(e.region);
     if (e.kind == FitParameter::Kind::Young) {
       r.young_along = b.young_along, r.young_through = b.young_through, r.young_around = b.young_around;
-      r.scale_young(std::exp(p[i]));  // the base's moduli times e^p
+      r = perturbed_material(r, MaterialParameter::LogYoung, p[i]);  // the base's moduli times e^p
     } else if (e.kind == FitParameter::Kind::FungC) {
-      r.fung_c = b.fung_c * std::exp(p[i]);
+      r.fung_c = b.fung_c;
+      r = perturbed_material(r, MaterialParameter::LogFungC, p[i]);  // the base's Fung c times e^p
     } else {
       r.poisson = p[i];
     }

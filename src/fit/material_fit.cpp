@@ -16,6 +16,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
 #include "fit/fit_problem.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh {
 namespace {
@@ -215,35 +216,32 @@ void write_fit_error_svg(const MaterialFitResult& r, const std::string& path, co
   ymax = std::ceil(ymax / step) * step;
   auto X = [&](double t) { return L + (t - t0) / (t1 - t0) * (W - L - R); };
   auto Y = [&](double v) { return H - B - v / ymax * (H - T - B); };
-  std::ofstream f(path + ".partial");
-  if (!f) fail(path, ": cannot write");
-  f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
-    << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
-  f << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
-  for (double v = 0; v <= ymax + 1e-12; v += step)
-    f << "<line x1='" << L << "' y1='" << Y(v) << "' x2='" << W - R << "' y2='" << Y(v) << "' stroke='#ddd'/><text x='"
-      << L - 6 << "' y='" << Y(v) + 4 << "' text-anchor='end'>" << v << "</text>\n";
-  f << "<rect x='" << L << "' y='" << T << "' width='" << W - L - R << "' height='" << H - T - B
-    << "' fill='none' stroke='black'/>\n";
-  f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 15 << "' text-anchor='middle'>time (s); " << t0 << " to " << t1
-    << "</text>\n";
-  f << "<text transform='translate(20," << (T + H - B) / 2
-    << ") rotate(-90)' text-anchor='middle'>surface error RMS per frame (mm)</text>\n";
-  auto series = [&](const std::vector<double>& v, const char* color, const char* label, int row) {
-    f << "<polyline fill='none' stroke='" << color << "' stroke-width='2' points='";
-    for (size_t i = 0; i < v.size(); ++i) f << X(r.frame_time[i]) << "," << Y(v[i] * 1e3) << " ";
-    f << "'/>\n<text x='" << W - R - 10 << "' y='" << T + 18 * row << "' text-anchor='end' fill='" << color << "'>"
-      << label << "</text>\n";
-  };
-  char before[80], after[80];
-  std::snprintf(before, sizeof before, "before the fit (RMS %.2f mm)", r.rms_before * 1e3);
-  std::snprintf(after, sizeof after, "after the fit (RMS %.2f mm)", r.rms_after * 1e3);
-  series(r.frame_rms_before, "#d62728", before, 1);
-  series(r.frame_rms_after, "#1f77b4", after, 2);
-  f << "</svg>\n";
-  f.close();
-  if (!f) fail(path, ": write failed");
-  std::filesystem::rename(path + ".partial", path);
+  io::write_text_file(path, [&](std::ostream& f) {
+    f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
+      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
+    f << "<text x='" << W / 2 << "' y='24' text-anchor='middle' font-size='15'>" << title << "</text>\n";
+    for (double v = 0; v <= ymax + 1e-12; v += step)
+      f << "<line x1='" << L << "' y1='" << Y(v) << "' x2='" << W - R << "' y2='" << Y(v) << "' stroke='#ddd'/><text x='"
+        << L - 6 << "' y='" << Y(v) + 4 << "' text-anchor='end'>" << v << "</text>\n";
+    f << "<rect x='" << L << "' y='" << T << "' width='" << W - L - R << "' height='" << H - T - B
+      << "' fill='none' stroke='black'/>\n";
+    f << "<text x='" << (L + W - R) / 2 << "' y='" << H - 15 << "' text-anchor='middle'>time (s); " << t0 << " to " << t1
+      << "</text>\n";
+    f << "<text transform='translate(20," << (T + H - B) / 2
+      << ") rotate(-90)' text-anchor='middle'>surface error RMS per frame (mm)</text>\n";
+    auto series = [&](const std::vector<double>& v, const char* color, const char* label, int row) {
+      f << "<polyline fill='none' stroke='" << color << "' stroke-width='2' points='";
+      for (size_t i = 0; i < v.size(); ++i) f << X(r.frame_time[i]) << "," << Y(v[i] * 1e3) << " ";
+      f << "'/>\n<text x='" << W - R - 10 << "' y='" << T + 18 * row << "' text-anchor='end' fill='" << color << "'>"
+        << label << "</text>\n";
+    };
+    char before[80], after[80];
+    std::snprintf(before, sizeof before, "before the fit (RMS %.2f mm)", r.rms_before * 1e3);
+    std::snprintf(after, sizeof after, "after the fit (RMS %.2f mm)", r.rms_after * 1e3);
+    series(r.frame_rms_before, "#d62728", before, 1);
+    series(r.frame_rms_after, "#1f77b4", after, 2);
+    f << "</svg>\n";
+  });
 }
 
 }  // namespace sflsh

@@ -14,7 +14,7 @@ BoneSequence motion_bones(const Avatar& avatar, const MotionClip& motion, double
   if (start_at_rest) {
     seq.bones_before = seq.bones[0];
   } else {
-    // As run_simulation: q_{-1} = Δ⁻¹ q_0 with Δ = G(h) G(0)⁻¹ per bone.
+    // As a run starts moving (CompiledBody::initial_state): q_{-1} = Δ⁻¹ q_0 with Δ = G(h) G(0)⁻¹ per bone.
     const std::vector<Isometry> next = target_bones(avatar, motion.sample(h));
     seq.bones_before = bones_one_step_before(seq.bones[0], next);
   }

@@ -10,6 +10,9 @@
 #include <sstream>
 
 #include "fit/fit_problem.hpp"
+#include "sflsh/io/atomic_output.hpp"
+#include "sflsh/scene/yaml_document.hpp"
+#include "sflsh/sim/elastic_sensitivity.hpp"
 
 namespace sflsh {
 namespace {
@@ -179,10 +182,7 @@ std::string ShapeMapResult::describe(const std::vector<FitSubject>& subjects) co
 }
 
 void write_shape_map(const std::string& path, const ShapeMap& map, const std::vector<std::string>& comment) {
-  const std::string partial = path + ".partial";
-  {
-    std::ofstream f(partial);
-    if (!f) fail(path, ": cannot write the shape map");
+  io::write_text_file(path, [&](std::ostream& f) {
     f.precision(17);
     for (const std::string& c : comment) f << "# " << c << "\n";
     f << "# p(beta) = p0 + sum_k beta_k pk[k]; young/fung_c: log factors on the avatar's materials\n";
@@ -192,23 +192,11 @@ void write_shape_map(const std::string& path, const ShapeMap& map, const std::ve
       for (int k = 0; k < map.pk.cols(); ++k) f << (k ? ", " : "") << map.pk(i, k);
       f << "]}\n";
     }
-    f.close();
-    if (!f) {
-      std::filesystem::remove(partial);
-      fail(path, ": write failed");
-    }
-  }
-  std::filesystem::rename(partial, path);
+  });
 }
 
 ShapeMap read_shape_map(const std::string& path) {
-  require(std::filesystem::exists(path), path, ": shape map not found");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    fail(path, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path, "shape map");
   require(root.IsMap() && root["parameters"] && root["parameters"].IsSequence(), path,
           ": expected 'parameters:' with a list of {name, p0, pk}");
   const YAML::Node ps = root["parameters"];
@@ -217,19 +205,19 @@ ShapeMap read_shape_map(const std::string& path) {
   int nb = -1;
   for (size_t i = 0; i < ps.size(); ++i) {
     const YAML::Node p = ps[i];
-    require(p.IsMap() && p["name"] && p["p0"] && p["pk"] && p["pk"].IsSequence(), path, ":", p.Mark().line + 1,
+    require(p.IsMap() && p["name"] && p["p0"] && p["pk"] && p["pk"].IsSequence(), yaml_where(path, p),
             ": each parameter needs name, p0 and pk (a list)");
     try {
       m.labels.push_back(p["name"].as<std::string>());
       m.p0[i] = p["p0"].as<double>();
       const std::vector<double> pk = p["pk"].as<std::vector<double>>();
       if (nb < 0) nb = int(pk.size()), m.pk = MatX::Zero(ps.size(), nb);
-      require(int(pk.size()) == nb, path, ":", p.Mark().line + 1, ": pk has ", pk.size(), " entries, the first had ", nb);
+      require(int(pk.size()) == nb, yaml_where(path, p), ": pk has ", pk.size(), " entries, the first had ", nb);
       for (int k = 0; k < nb; ++k) m.pk(i, k) = pk[k];
     } catch (const YAML::Exception&) {
-      fail(path, ":", p.Mark().line + 1, ": name must be a string, p0 a number and pk a list of numbers");
+      fail(yaml_where(path, p), ": name must be a string, p0 a number and pk a list of numbers");
     }
-    require(std::isfinite(m.p0[i]) && m.pk.row(i).allFinite(), path, ":", p.Mark().line + 1, ": non-finite value");
+    require(std::isfinite(m.p0[i]) && m.pk.row(i).allFinite(), yaml_where(path, p), ": non-finite value");
   }
   return m;
 }
@@ -251,15 +239,16 @@ std::vector<RegionMaterial> shape_map_materials(const ShapeMap& map, const Avata
     auto it = std::find_if(m.begin(), m.end(), [&](const RegionMaterial& r) { return r.name == region; });
     require(it != m.end(), "shape map: region '", region, "' of '", label, "' is not one of the avatar's");
     if (kind == "young") {
-      it->scale_young(std::exp(p[i]));
+      *it = perturbed_material(*it, MaterialParameter::LogYoung, p[i]);
     } else if (kind == "fung_c") {
-      it->fung_c *= std::exp(p[i]);
+      *it = perturbed_material(*it, MaterialParameter::LogFungC, p[i]);
     } else if (kind == "poisson") {
-      require(p[i] > -1 && p[i] < 0.5, "shape map: poisson of '", region, "' evaluates to ", p[i], " for these betas");
       it->poisson = p[i];
     } else {
       fail("shape map: unknown parameter kind '", kind, "' in '", label, "'");
     }
+    const std::string problem = it->range_problem();
+    require(problem.empty(), "shape map: region '", region, "' for these betas: ", problem);
   }
   return m;
 }

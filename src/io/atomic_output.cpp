@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include <unistd.h>
@@ -35,6 +36,18 @@ void AtomicOutput::commit() {
   fs::rename(temp_path_, path_, ec);
   if (ec) fail(path_, ": cannot rename ", temp_path_, " into place: ", ec.message());
   committed_ = true;
+}
+
+void write_text_file(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.temp_path());
+    if (!f) fail(path, ": cannot write");
+    write(f);
+    f.close();
+    if (!f) fail(path, ": write failed");
+  }
+  out.commit();
 }
 
 namespace {

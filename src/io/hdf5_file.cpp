@@ -76,14 +76,8 @@ Hdf5File::Hdf5File(const std::string& path, Mode mode) : path_(path), mode_(mode
     file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file_ < 0) fail(path, ": cannot open HDF5 file (truncated or corrupted?)");
   } else {
-    write_path_ = path + ".partial";
-    auto parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) {  // like AtomicOutput: missing folders are made
-      std::error_code ec;
-      std::filesystem::create_directories(parent, ec);
-      if (ec) fail(path, ": cannot create folder ", parent.string(), ": ", ec.message());
-    }
-    file_ = H5Fcreate(write_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    out_ = std::make_unique<AtomicOutput>(path);
+    file_ = H5Fcreate(out_->temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file_ < 0) fail(path, ": cannot create file");
   }
 }
@@ -96,10 +90,7 @@ void Hdf5File::close_appendable() {
 Hdf5File::~Hdf5File() {
   close_appendable();
   if (file_ >= 0) H5Fclose(file_);
-  if (mode_ == Mode::Write && !committed_) {
-    std::error_code ec;
-    std::filesystem::remove(write_path_, ec);
-  }
+  out_.reset();  // removes the partial file unless committed
 }
 
 void Hdf5File::commit() {
@@ -107,10 +98,7 @@ void Hdf5File::commit() {
   close_appendable();
   if (H5Fclose(file_) < 0) fail(path_, ": failed to flush/close");
   file_ = -1;
-  std::error_code ec;
-  std::filesystem::rename(write_path_, path_, ec);
-  if (ec) fail(path_, ": cannot rename ", write_path_, " into place: ", ec.message());
-  committed_ = true;
+  out_->commit();
 }
 
 bool Hdf5File::has(const std::string& name) const {

@@ -59,10 +59,7 @@ void write_line_plot_svg(const std::string& path, const std::string& title, cons
   const double W = 860, H = 480, L = 80, R = 230, T = 50, B = 60;
   auto X = [&](double v) { return L + (v - x0) / (x1 - x0) * (W - L - R); };
   auto Y = [&](double v) { return H - B - (v - y0) / (y1 - y0) * (H - T - B); };
-  AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    require(bool(f), path, ": cannot write");
+  write_text_file(path, [&](std::ostream& f) {
     f << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H
       << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
     f << "<text x='" << (L + W - R) / 2 << "' y='24' text-anchor='middle' font-size='15'>" << escape(title)
@@ -93,9 +90,7 @@ void write_line_plot_svg(const std::string& path, const std::string& title, cons
         << W - R + 50 << "' y='" << ly + 4 << "'>" << escape(s.label) << "</text>\n";
     }
     f << "</svg>\n";
-    require(bool(f), path, ": writing failed");
-  }
-  out.commit();
+  });
 }
 
 }  // namespace sflsh::io

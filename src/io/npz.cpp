@@ -14,6 +14,7 @@
 
 #include "io/npz_internal.hpp"
 #include "sflsh/core/error.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::io {
 
@@ -206,7 +207,8 @@ NpyArray read_npy_bytes(const std::string& bytes, const std::string& name) {
 }
 
 void write_npz(const std::string& path, const std::map<std::string, NpyArray>& arrays, bool compressed) {
-  const std::string tmp = path + ".partial";
+  AtomicOutput out(path);  // removes the partial archive unless committed
+  const std::string& tmp = out.temp_path();
   std::error_code ec;
   std::filesystem::remove(tmp, ec);
   int err = 0;
@@ -231,21 +233,14 @@ void write_npz(const std::string& path, const std::map<std::string, NpyArray>& a
     }
   } catch (...) {
     zip_discard(z);
-    std::filesystem::remove(tmp, ec);
     throw;
   }
   if (zip_close(z) != 0) {
     const std::string msg = zip_strerror(z);
     zip_discard(z);
-    std::filesystem::remove(tmp, ec);
     fail(path, ": cannot write archive: ", msg);
   }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    const std::string msg = ec.message();
-    std::filesystem::remove(tmp, ec);
-    fail(path, ": cannot move ", tmp, " into place: ", msg);
-  }
+  out.commit();
 }
 
 }  // namespace sflsh::io

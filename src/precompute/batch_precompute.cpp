@@ -330,18 +330,13 @@ BatchRecord precompute_batch_row(const BatchRecord& pending, const BatchShape& s
 }
 
 void write_batch_manifest(const std::vector<BatchRecord>& records, const std::string& path) {
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path());
-    if (!f) fail(path, ": cannot write the manifest");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << kManifestHeader << '\n';
     for (const BatchRecord& r : records)
       f << r.row << ',' << r.line << ',' << csv_field(r.name) << ',' << r.key << ',' << csv_field(r.file) << ','
         << r.status << ',' << r.topology << ',' << fixed(r.seconds, 3) << ',' << fixed(r.peak_rss_mib, 1) << ',' << csv_field(r.error)
         << '\n';
-    if (!f) fail(path, ": write failed");
-  }
-  out.commit();
+  });
 }
 
 std::vector<BatchRecord> read_batch_manifest(const std::string& path) {

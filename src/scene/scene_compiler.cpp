@@ -298,6 +298,7 @@ Isometry CompiledBody::placement_at(double t) const {
 
 BodyPose CompiledBody::target_pose(double t) const {
   BodyPose pose = has_motion ? motion.sample(t) : BodyPose{};
+  if (!placed) return pose;
   const Isometry P = placement_at(t);
   const Vec3 root = avatar->joints_rest.row(0).transpose();
   pose.axis_angle.row(0) = rotation_log(P.linear() * rodrigues(pose.axis_angle.row(0).transpose())).transpose();
@@ -310,7 +311,9 @@ BodyState CompiledBody::initial_state(double h) const {
   s.q.bones = target_bones(*avatar, target_pose(0.0));
   s.q.z = VecX::Zero(avatar->num_reduced());
   s.q_prev.z = s.q.z;
-  if (has_motion) {
+  if (start_at_rest) {
+    s.q_prev.bones = s.q.bones;
+  } else if (has_motion) {
     s.q_prev.bones = bones_one_step_before(s.q.bones, target_bones(*avatar, target_pose(h)));
   } else {
     s.q_prev.bones = s.q.bones;
@@ -330,6 +333,7 @@ Isometry CompiledTool::jaw_in_tool(const CompiledJaw& j, double closure) const {
 CompiledScene compile_scene(const SceneDescription& sc, const SceneCompileOptions& opt) {
   require(!sc.bodies.empty(), sc.path, ": the scene has no bodies");
   CompiledScene cs;
+  cs.name = sc.path.empty() ? std::string("scene") : sc.path;
   cs.h = sc.solver.dt;
   cs.bodies = compile_bodies(sc, cs.seconds);
   require(cs.seconds > 0, sc.path, ": solver.seconds is 0 and no body has a motion; give solver.seconds");
@@ -342,6 +346,30 @@ CompiledScene compile_scene(const SceneDescription& sc, const SceneCompileOption
   for (const ToolDescription& d : sc.tools) cs.tools.push_back(add_tool(mb, d, cs.bodies, sc.contact, samples));
   add_body_contacts(mb, cs.bodies, sc);
   cs.model = mb.build();
+  mark_stiffness_terms(*cs.model, cs.bodies);
+  cs.initial = initial_state(*cs.model, cs);
+  return cs;
+}
+
+CompiledScene compile_avatar_motion(const SceneDescription& sc, std::shared_ptr<const Avatar> avatar,
+                                    const MotionClip& motion, const SimulatorOptions& sim,
+                                    const SkeletonTermsOptions& skeleton, bool start_at_rest) {
+  require(sc.bodies.size() == 1, "compile_avatar_motion: ", sc.bodies.size(), " bodies, expected 1");
+  CompiledScene cs;
+  cs.name = motion.name;
+  cs.one_avatar = true;
+  cs.h = sim.h;
+  cs.seconds = sc.solver.seconds > 0 ? sc.solver.seconds : motion.duration();
+  cs.steps = std::max(1L, long(std::llround(cs.seconds / cs.h)));
+  CompiledBody b;
+  b.desc = &sc.bodies[0];
+  b.avatar = avatar;
+  b.has_motion = true;
+  b.motion = motion;
+  b.placed = false;
+  b.start_at_rest = start_at_rest;
+  cs.bodies.push_back(std::move(b));
+  cs.model = avatar_model(std::move(avatar), sim, sim.bones_dynamic ? &skeleton : nullptr, sc.bodies[0].name);
   mark_stiffness_terms(*cs.model, cs.bodies);
   cs.initial = initial_state(*cs.model, cs);
   return cs;

@@ -1,5 +1,6 @@
 // Reading a scene file: the top level (bodies, objects and tools with unique names, then the settings).
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/yaml_document.hpp"
 
 #include <fstream>
 #include <set>
@@ -43,12 +44,7 @@ SceneDescription read_scene_description(const std::string& path) {
 }
 
 SceneDescription parse_scene_description(const std::string& yaml_text, const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    fail(path, ":", e.mark.line + 1, ": malformed YAML: ", e.msg);
-  }
+  const YAML::Node root = load_yaml_text(yaml_text, path);
   const fs::path folder = fs::absolute(path).parent_path();
   const SceneParser p(path, folder);
   if (!root.IsMap()) fail(path, ": expected a map with 'bodies' (and optionally objects, contact, solver, output)");

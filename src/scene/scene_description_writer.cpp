@@ -239,15 +239,9 @@ std::string scene_description_yaml(const SceneDescription& scene) {
 
 void write_scene_description(const SceneDescription& scene, const std::string& path) {
   const std::string text = scene_description_yaml(scene);
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path(), std::ios::binary);
-    require(bool(f), path, ": cannot open for writing");
+  io::write_text_file(path, [&](std::ostream& f) {
     f << text;
-    f.close();
-    require(bool(f), path, ": write failed (disk full?)");
-  }
-  out.commit();
+  });
 }
 
 }  // namespace sflsh

@@ -15,6 +15,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/yaml_document.hpp"
 
 namespace sflsh::scene_yaml {
 
@@ -41,9 +42,7 @@ class SceneParser {
   const std::string& file() const { return file_; }
 
   /// "FILE:LINE" of a node (the line of its first character).
-  std::string where(const YAML::Node& n) const {
-    return n.Mark().is_null() ? file_ : file_ + ":" + std::to_string(n.Mark().line + 1);
-  }
+  std::string where(const YAML::Node& n) const { return yaml_where(file_, n); }
 
   template <class... A>
   [[noreturn]] void error(const YAML::Node& n, const std::string& key, const A&... msg) const {

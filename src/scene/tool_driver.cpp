@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "sflsh/core/error.hpp"
+#include "sflsh/scene/scene_session.hpp"
 #include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/energies/virtual_coupling.hpp"
@@ -13,6 +14,7 @@
 #include "sflsh/teleop/pose_recorder.hpp"
 #include "sflsh/teleop/pose_stream_link.hpp"
 #include "sflsh/teleop/pose_track.hpp"
+#include "scene/scene_run_state.hpp"
 
 namespace sflsh {
 namespace {
@@ -258,6 +260,37 @@ std::string ToolDriver::finish_recording() {
   std::string path = recorder_->path();
   recorder_.reset();
   return path;
+}
+
+// The scene's tools as SceneSession shows them.
+
+const std::vector<SceneToolEvent>& SceneSession::tool_events() const { return impl_->events; }
+
+int SceneSession::num_tools() const { return int(impl_->tools.size()); }
+const std::string& SceneSession::tool_name(int tool) const { return impl_->tools.at(tool).name(); }
+int SceneSession::tool_index(const std::string& name) const {
+  std::string known;
+  for (size_t i = 0; i < impl_->tools.size(); ++i) {
+    if (impl_->tools[i].name() == name) return int(i);
+    known += (known.empty() ? "" : ", ") + impl_->tools[i].name();
+  }
+  fail(impl_->sc.path, ": no tool named '", name, "' (tools: ", known.empty() ? "none" : known, ")");
+}
+const SceneToolState& SceneSession::tool_state(int tool) const { return impl_->tools.at(tool).state(); }
+const CompiledTool& SceneSession::compiled_tool(int tool) const { return impl_->tools.at(tool).tool(); }
+void SceneSession::set_device_pose(int tool, const teleop::PoseSample& sample) { impl_->tools.at(tool).push(sample); }
+int SceneSession::stream_port(int tool) const { return impl_->tools.at(tool).stream_port(); }
+std::string SceneSession::stream_counters(int tool) const { return impl_->tools.at(tool).stream_counters(); }
+
+void SceneSession::end_feedback() {
+  for (ToolDriver& t : impl_->tools) t.end_feedback();
+}
+
+std::vector<std::string> SceneSession::finish_recording() {
+  std::vector<std::string> paths;
+  for (ToolDriver& t : impl_->tools)
+    if (std::string p = t.finish_recording(); !p.empty()) paths.push_back(std::move(p));
+  return paths;
 }
 
 }  // namespace sflsh

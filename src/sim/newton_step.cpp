@@ -148,27 +148,147 @@ double total_energy(StepSystem& sys, const std::vector<Configuration>& q, VecX* 
   return E;
 }
 
-StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const NewtonOptions& o) {
-  require(o.iterations >= 1, "NewtonOptions::iterations = ", o.iterations, ", expected >= 1");
-  require(q.size() == sys.bodies.size(), "newton_minimize: ", q.size(), " configurations for ", sys.bodies.size(),
-          " bodies");
-  Timer total;
-  StepReport rep;
-  VecX g, g_final, delta;
-  MatX H;
+namespace {
+
+/// The Newton direction δ = −H⁻¹ g: the sparse solver when chosen (it shifts H
+/// itself when H does not factor), else the dense Cholesky with the
+/// regularization shift (solve_in_place). Counts into rep.ms_solve.
+void newton_direction(StepSystem& sys, MatX& H, const VecX& g, const NewtonOptions& o, VecX& delta, StepReport& rep) {
+  Timer ts;
+  bool solved = false;
+  if (o.linear_solver == LinearSolver::Sparse) {
+    if (!sys.sparse_solver)
+      sys.sparse_solver = o.sparse_always ? std::make_shared<SparseHessianSolver>(1.0, 0.0)
+                                          : std::make_shared<SparseHessianSolver>();
+    solved = sys.sparse_solver->solve(H, g, delta);
+    if (solved) rep.regularization = 0.0, ++rep.sparse_solves;
+  }
+  if (!solved) solve_in_place(H, g, o.regularization, delta, &rep.regularization);
+  rep.ms_solve += ts.ms();
+}
+
+/// A Newton step limited by the caps (sim/step_cap.hpp): the step taken is
+/// alpha·delta. Either cap counts the step as damped.
+struct CappedStep {
+  double alpha = 1.0;
+  double slope = 0;            ///< Armijo's slope along delta
+  bool bones_capped = false;   ///< delta is the per-bone capped step
+  VecX whole;                  ///< bones_capped: the uncapped direction, to fall back to
+  double whole_alpha = 1.0;    ///< bones_capped: the scale that caps `whole` as a whole
+};
+
+/// Leaf bones over the rotation cap are capped alone (the handle cap still
+/// scales the whole step). If an inner bone is over it, the whole step is
+/// scaled to the caps. `slope` = gᵀδ of the uncapped direction.
+CappedStep cap_step(const StepSystem& sys, const std::vector<Configuration>& q, const VecX& g, double slope,
+                    VecX& delta, const NewtonOptions& o) {
+  CappedStep c;
+  c.slope = slope;
+  if (o.max_rotation_step > 0 && rotation_step_scale(delta, sys.bodies, o.max_rotation_step) < 1.0 &&
+      rotation_cap_per_bone_applies(delta, sys.bodies, body_parents(sys), o.max_rotation_step)) {
+    c.whole = delta;
+    c.whole_alpha = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
+                             rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
+    cap_bone_rotations(delta, q, sys.bodies, o.max_rotation_step);
+    c.alpha = handle_step_scale(delta, sys.bodies, o.max_z_step);
+    // Armijo's slope along the capped direction; one that does not descend may not raise E.
+    c.slope = std::min(0.0, g.dot(delta));
+    c.bones_capped = true;
+  } else {
+    c.alpha = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
+                       rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
+  }
+  return c;
+}
+
+/// What the trial evaluations leave for the step's report.
+struct TrialRecord {
+  VecX g_final;                 ///< the gradient at the final configuration (when final_valid)
   std::vector<double> per_term, term_ms;
-  bool final_valid = false;  // g_final/per_term hold the final configuration's values
+  bool final_valid = false;     ///< g_final/per_term hold the final configuration's values
+};
+
+/// Halves c.alpha from the capped step until the trial is admissible (with
+/// `line_search`: and lowers the energy by Armijo's rule), at most kMaxHalvings
+/// times; when the per-bone capped step fails, falls back once to the whole
+/// step scaled to the caps. Returns whether a trial was found (`trial`, `E_trial`).
+/// On the `last` iteration the trial evaluation doubles as the final report's.
+bool search_step(StepSystem& sys, const std::vector<Configuration>& q, VecX& delta, CappedStep& c, double E0,
+                 double slope, bool line_search, bool last, TrialRecord& rec, std::vector<Configuration>& trial,
+                 double& E_trial) {
+  for (int halving = 0; halving <= kMaxHalvings; ++halving, c.alpha *= 0.5) {
+    trial = retract_all(q, c.alpha * delta, sys.bodies);
+    const double E1 = total_energy(sys, trial, last ? &rec.g_final : nullptr, nullptr, last ? &rec.per_term : nullptr,
+                                   &rec.term_ms);
+    rec.final_valid = last;
+    const bool admissible = std::isfinite(E1);
+    if (line_search ? (admissible && E1 <= E0 + kArmijo * c.alpha * c.slope) : admissible) {
+      E_trial = E1;
+      return true;
+    }
+    if (c.bones_capped && c.whole.size() > 0) {  // fall back to the whole step scaled to the caps
+      delta = std::move(c.whole);
+      c.whole.resize(0);
+      c.alpha = 2.0 * c.whole_alpha;  // halved by the loop's increment
+      c.slope = slope;
+      c.bones_capped = false;
+      --halving;
+    }
+  }
+  return false;
+}
+
+/// The step's final figures: energy and gradient norm after it (report_final;
+/// evaluated unless the last trial already did) and each term's energy and time.
+void finish_report(StepSystem& sys, const std::vector<Configuration>& q, const NewtonOptions& o, TrialRecord& rec,
+                   StepReport& rep) {
+  rep.energy_after = rep.grad_norm_after = std::numeric_limits<double>::quiet_NaN();
+  const size_t T = sys.terms.size();
+  if (rec.term_ms.size() < T) rec.term_ms.resize(T, 0.0);
+  if (o.report_final) {
+    if (!rec.final_valid) {
+      Timer ta;
+      total_energy(sys, q, &rec.g_final, nullptr, &rec.per_term, &rec.term_ms);
+      rep.ms_assemble += ta.ms();
+    }
+    rep.energy_after = 0;
+    for (double e : rec.per_term) rep.energy_after += e;
+    rep.grad_norm_after = rec.g_final.norm();
+    for (size_t i = 0; i < T; ++i)
+      rep.energies.push_back({sys.terms[i].term->name(), rec.per_term[i], rec.term_ms[i], sys.terms[i].active});
+  } else {
+    for (size_t i = 0; i < T; ++i)
+      rep.energies.push_back({sys.terms[i].term->name(), std::numeric_limits<double>::quiet_NaN(), rec.term_ms[i],
+                              sys.terms[i].active});
+  }
+}
+
+void check_newton_options(const NewtonOptions& o) {
+  require(o.iterations >= 1, "NewtonOptions::iterations = ", o.iterations, ", expected >= 1");
   require(o.iterations_after_damping >= 0, "NewtonOptions::iterations_after_damping = ", o.iterations_after_damping,
           ", expected >= 0");
   require(!o.nonlinearity_tolerance || (*o.nonlinearity_tolerance >= 0 && std::isfinite(*o.nonlinearity_tolerance)),
           "NewtonOptions::nonlinearity_tolerance = ", o.nonlinearity_tolerance.value_or(0),
           ", expected finite and >= 0 (or unset: automatic)");
+}
+
+}  // namespace
+
+StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const NewtonOptions& o) {
+  check_newton_options(o);
+  require(q.size() == sys.bodies.size(), "newton_minimize: ", q.size(), " configurations for ", sys.bodies.size(),
+          " bodies");
+  Timer total;
+  StepReport rep;
+  VecX g, delta;
+  MatX H;
+  TrialRecord rec;
   const double nonlinearity_tolerance = o.nonlinearity_tolerance.value_or(
       only_soft_dofs(sys) ? kAutoNonlinearityTolerance : 0.0);
   int planned = o.iterations;  // grows while the last iteration is damped (iterations_after_damping)
   for (int it = 0; it < planned; ++it) {
     Timer ta;
-    const double E0 = total_energy(sys, q, &g, &H, nullptr, &term_ms);
+    const double E0 = total_energy(sys, q, &g, &H, nullptr, &rec.term_ms);
     rep.ms_assemble += ta.ms();
     require(std::isfinite(E0) && g.allFinite(), "newton_minimize: energy or gradient is not finite at the start of "
             "iteration ", it, " (E = ", E0, "); the configuration is inadmissible");
@@ -180,95 +300,43 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
     if (o.gradient_tolerance > 0 && gnorm <= o.gradient_tolerance) break;
     ++rep.iterations;
 
-    Timer ts;
-    bool solved = false;
-    if (o.linear_solver == LinearSolver::Sparse) {
-      if (!sys.sparse_solver)
-        sys.sparse_solver = o.sparse_always ? std::make_shared<SparseHessianSolver>(1.0, 0.0)
-                                            : std::make_shared<SparseHessianSolver>();
-      solved = sys.sparse_solver->solve(H, g, delta);
-      if (solved) rep.regularization = 0.0, ++rep.sparse_solves;
-    }
-    if (!solved) solve_in_place(H, g, o.regularization, delta, &rep.regularization);
-    rep.ms_solve += ts.ms();
+    newton_direction(sys, H, g, o, delta, rep);
     const double slope = g.dot(delta);  // = −δᵀ(H + shift)δ < 0
     if (it == 0) rep.newton_decrement = std::sqrt(std::max(0.0, -slope));
 
-    // Caps (sim/step_cap.hpp); either counts the step as damped. Leaf bones
-    // over the rotation cap are capped alone (the handle cap still scales the
-    // whole step). If an inner bone is over it, or the per-bone step is not
-    // admissible (an inverted element), the whole step is scaled to the caps.
     Timer tl;
-    double alpha = 1.0, capped_slope = slope, a_whole = 1.0;
-    bool bones_capped = false;  // the per-bone capped step is being tried
-    VecX whole;
-    if (o.max_rotation_step > 0 && rotation_step_scale(delta, sys.bodies, o.max_rotation_step) < 1.0 &&
-        rotation_cap_per_bone_applies(delta, sys.bodies, body_parents(sys), o.max_rotation_step)) {
-      whole = delta;
-      a_whole = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
-                         rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
-      cap_bone_rotations(delta, q, sys.bodies, o.max_rotation_step);
-      alpha = handle_step_scale(delta, sys.bodies, o.max_z_step);
-      // Armijo's slope along the capped direction; one that does not descend may not raise E.
-      capped_slope = std::min(0.0, g.dot(delta));
-      bones_capped = true;
-    } else {
-      alpha = std::min(handle_step_scale(delta, sys.bodies, o.max_z_step),
-                       rotation_step_scale(delta, sys.bodies, o.max_rotation_step));
-    }
+    CappedStep c = cap_step(sys, q, g, slope, delta, o);
     std::vector<Configuration> trial;
-    bool ok = false;
     double E_trial = E0;
     // An iteration added after a damped one must lower the step's objective (Armijo):
     // without that, on targets jumping ~3 rad (builtin:torture) the added iterations
     // carried the bones through in one step and crushed the flesh they drag.
     const bool added = it >= o.iterations;
-    const bool line_search = o.line_search || added;
-    // On the last iteration the trial evaluation doubles as the final report's.
     const bool last = it + 1 == planned && o.report_final;
-    for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
-      trial = retract_all(q, alpha * delta, sys.bodies);
-      const double E1 =
-          total_energy(sys, trial, last ? &g_final : nullptr, nullptr, last ? &per_term : nullptr, &term_ms);
-      final_valid = last;
-      const bool admissible = std::isfinite(E1);
-      if (line_search ? (admissible && E1 <= E0 + kArmijo * alpha * capped_slope) : admissible) {
-        ok = true;
-        E_trial = E1;
-        break;
-      }
-      if (bones_capped && whole.size() > 0) {  // fall back to the whole step scaled to the caps
-        delta = std::move(whole);
-        whole.resize(0);
-        alpha = 2.0 * a_whole;  // halved by the loop's increment
-        capped_slope = slope;
-        bones_capped = false;
-        --halving;
-      }
-    }
+    const bool ok = search_step(sys, q, delta, c, E0, slope, o.line_search || added, last, rec, trial, E_trial);
     rep.ms_assemble += tl.ms();
     // Converged to round-off: the line search found no decrease, but the
     // predicted one is below what the energy resolves. The iterate is the
     // minimum (e.g. a held grasp at rest); keep it and stop, not a rejection.
     if (!ok && o.line_search && -slope <= 1e-12 * std::max(1.0, std::abs(E0))) {
-      final_valid = false;
+      rec.final_valid = false;
       break;
     }
     // An added iteration that finds no decrease ends the step where the planned ones left it.
     if (!ok && added) {
-      final_valid = false;
+      rec.final_valid = false;
       break;
     }
     StepOutcome outcome;
     if (!ok) {
-      final_valid = false;
+      rec.final_valid = false;
       outcome = StepOutcome::Rejected;
       ++rep.rejected;
       rep.step_scale = 0;
     } else {
       q = std::move(trial);
-      rep.step_scale = alpha;
-      const bool full = alpha == 1.0 && !bones_capped;  // a_whole < 1 when the fallback ran
+      rep.step_scale = c.alpha;
+      const bool full = c.alpha == 1.0 && !c.bones_capped;  // whole_alpha < 1 when the fallback ran
       outcome = full ? StepOutcome::Accepted : StepOutcome::Damped;
       (full ? rep.accepted : rep.damped)++;
     }
@@ -287,26 +355,7 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
       }
     }
   }
-
-  rep.energy_after = rep.grad_norm_after = std::numeric_limits<double>::quiet_NaN();
-  const size_t T = sys.terms.size();
-  if (term_ms.size() < T) term_ms.resize(T, 0.0);
-  if (o.report_final) {
-    if (!final_valid) {
-      Timer ta;
-      total_energy(sys, q, &g_final, nullptr, &per_term, &term_ms);
-      rep.ms_assemble += ta.ms();
-    }
-    rep.energy_after = 0;
-    for (double e : per_term) rep.energy_after += e;
-    rep.grad_norm_after = g_final.norm();
-    for (size_t i = 0; i < T; ++i)
-      rep.energies.push_back({sys.terms[i].term->name(), per_term[i], term_ms[i], sys.terms[i].active});
-  } else {
-    for (size_t i = 0; i < T; ++i)
-      rep.energies.push_back({sys.terms[i].term->name(), std::numeric_limits<double>::quiet_NaN(), term_ms[i],
-                              sys.terms[i].active});
-  }
+  finish_report(sys, q, o, rec, rep);
   rep.ms_total = total.ms();
   return rep;
 }

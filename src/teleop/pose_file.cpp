@@ -270,16 +270,11 @@ std::string format_pose_row(const PoseSample& s, PoseFileFormat format) {
 
 void write_pose_file(const std::string& path, const std::vector<PoseSample>& samples) {
   const PoseFileFormat format = pose_file_format(path);
-  io::AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path(), std::ios::binary);
-    require(f.good(), out.temp_path(), ": cannot write the pose file");
+  io::write_text_file(path, [&](std::ostream& f) {
     const std::string header = pose_file_header(format);
     if (!header.empty()) f << header << '\n';
     for (const PoseSample& s : samples) f << format_pose_row(s, format) << '\n';
-    require(f.good(), out.temp_path(), ": write failed");
-  }
-  out.commit();
+  });
 }
 
 }  // namespace sflsh::teleop

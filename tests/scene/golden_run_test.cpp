@@ -29,15 +29,7 @@ struct Fingerprint {
 };
 
 /// Synthetic box (8 hat handles, sampled cubature) carrying the T-pose skeleton.
-std::shared_ptr<const Avatar> golden_avatar() {
-  test::SyntheticAvatarOptions so;
-  so.handles = 8;
-  so.all_tets = false;
-  so.samples = 12;
-  Avatar a = test::make_synthetic_avatar(so);
-  a.joints_rest = test::make_tpose_skeleton().joints_rest;
-  return std::make_shared<const Avatar>(std::move(a));
-}
+std::shared_ptr<const Avatar> golden_avatar() { return test::make_tpose_box(8, 12); }
 
 Fingerprint run(bool bones_dynamic, double damping, int newton_iters,
                 SkeletonTermsOptions::SpringInertia springs = SkeletonTermsOptions::SpringInertia::Carried) {

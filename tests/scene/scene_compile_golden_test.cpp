@@ -31,39 +31,14 @@ using namespace sflsh;
 
 namespace {
 
-/// FNV-1a over the bytes of every value hashed: any change of a bit shows.
-class BitHash {
- public:
-  void add(double x) { add_bytes(&x, sizeof x); }
-  void add(int x) { add_bytes(&x, sizeof x); }
-  void add(const Isometry& T) {
-    for (int i = 0; i < 16; ++i) add(T.matrix().data()[i]);
-  }
-  void add(const VecX& v) {
-    add(int(v.size()));
-    for (Eigen::Index i = 0; i < v.size(); ++i) add(v[i]);
-  }
-  void add(const Vec3& v) {
-    for (int i = 0; i < 3; ++i) add(v[i]);
-  }
-  void add(const Configuration& q) {
-    add(int(q.bones.size()));
-    for (const Isometry& G : q.bones) add(G);
-    add(q.z);
-  }
-  std::string hex() const {
-    char s[17];
-    std::snprintf(s, sizeof s, "%016llx", static_cast<unsigned long long>(h_));
-    return s;
-  }
+using test::BitHash;
 
- private:
-  void add_bytes(const void* p, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(p);
-    for (size_t i = 0; i < n; ++i) h_ = (h_ ^ b[i]) * 1099511628211ull;
-  }
-  std::uint64_t h_ = 1469598103934665603ull;
-};
+/// A configuration: its bones (count, then each transform) and z.
+void add(BitHash& h, const Configuration& q) {
+  h.add(int(q.bones.size()));
+  for (const Isometry& G : q.bones) h.add(G);
+  h.add(q.z);
+}
 
 /// The model's terms in order: "name@body,body" separated by "; ".
 std::string term_list(const Model& m) {
@@ -90,8 +65,8 @@ std::string state_hash(const SceneSession& s) {
   const State& st = s.simulator().scene_state();
   h.add(st.time);
   for (const BodyState& b : st.bodies) {
-    h.add(b.q);
-    h.add(b.q_prev);
+    add(h, b.q);
+    add(h, b.q_prev);
   }
   return h.hex();
 }

@@ -2,6 +2,7 @@
 // Test helpers for the skeletal terms (header-only; only *_test.cpp files are
 // compiled): a small T-pose SMPL skeleton, random configurations and
 // finite differences in the tangent space (perturbations through retract).
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "sflsh/core/rotation.hpp"
 #include "sflsh/sim/energies/bone_residual.hpp"
 #include "sflsh/sim/energy_term.hpp"
+#include "sim/synthetic_avatar.hpp"
 
 namespace sflsh::test {
 
@@ -181,6 +183,18 @@ inline MatX expect_residual_derivatives_match(const BoneLeastSquaresTerm& term, 
   EXPECT_LT(rel_error(J, fd_residual_jacobian(term, ctx, q)), 1e-7);
   EXPECT_GT(min_eigenvalue(H), -1e-9 * H.norm());
   return H;
+}
+
+/// The synthetic box of synthetic_avatar.hpp (`handles` hat handles,
+/// `samples` cubature samples per cubature) carrying the T-pose skeleton.
+inline std::shared_ptr<const Avatar> make_tpose_box(int handles, int samples) {
+  SyntheticAvatarOptions so;
+  so.handles = handles;
+  so.all_tets = false;
+  so.samples = samples;
+  Avatar a = make_synthetic_avatar(so);
+  a.joints_rest = make_tpose_skeleton().joints_rest;
+  return std::make_shared<const Avatar>(std::move(a));
 }
 
 }  // namespace sflsh::test

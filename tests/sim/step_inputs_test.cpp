@@ -36,15 +36,7 @@ class FrameProbeTerm : public EnergyTerm {
   std::string frame_;
 };
 
-std::shared_ptr<const Avatar> box() {
-  test::SyntheticAvatarOptions so;
-  so.handles = 4;
-  so.all_tets = false;
-  so.samples = 10;
-  Avatar a = test::make_synthetic_avatar(so);
-  a.joints_rest = test::make_tpose_skeleton().joints_rest;
-  return std::make_shared<const Avatar>(std::move(a));
-}
+std::shared_ptr<const Avatar> box() { return test::make_tpose_box(4, 10); }
 
 const TermQuantityReport* find(const StepReport& r, const std::string& term, const std::string& name) {
   for (const TermQuantityReport& q : r.quantities)

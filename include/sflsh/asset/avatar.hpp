@@ -58,6 +58,12 @@ struct RegionMaterial {
     young_through *= factor;
     young_around *= factor;
   }
+  /// What is out of range ("" when nothing is): Young's moduli, Fung c and
+  /// density must be > 0, Poisson's ratio in (−1, 0.5); e.g. "poisson = 0.6,
+  /// expected in (-1, 0.5)". The one range check of a region's material.
+  std::string range_problem() const;
+  /// Throws "material 'NAME': <range_problem()>" when out of range.
+  void require_in_range() const;
 };
 
 struct Avatar {

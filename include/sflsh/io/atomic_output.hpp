@@ -3,6 +3,8 @@
 // to "<path>.partial" next to the target (same file system) and is renamed
 // over <path> by commit(). Without commit() (an exception, an early return)
 // the partial file is removed, so a failed job leaves nothing behind.
+#include <functional>
+#include <iosfwd>
 #include <string>
 
 namespace sflsh::io {
@@ -26,6 +28,12 @@ class AtomicOutput {
   std::string path_, temp_path_;
   bool committed_ = false;
 };
+
+/// Writes the text file `path` through an AtomicOutput: `write` fills the
+/// stream, then the file is put in place. Throws "PATH: cannot write" when
+/// the file cannot be opened and "PATH: write failed" when writing fails
+/// (nothing is left at `path` then, nor a partial file).
+void write_text_file(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 /// Checks, before any work starts, that a file can be written at `path`: it is
 /// not a folder, and its nearest existing ancestor is a folder in which a file

@@ -10,11 +10,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/io/atomic_output.hpp"
 
 namespace sflsh::io {
 
@@ -136,10 +138,10 @@ class Hdf5File {
   void check_declared_size(const std::string& name, std::uint64_t count, std::uint64_t bytes_each) const;
   std::uint64_t file_bytes_ = 0;  // size of the file or image being read
   void ensure_parent_groups(const std::string& name);
-  std::string path_, write_path_;
+  std::string path_;
+  std::unique_ptr<AtomicOutput> out_;  // writing: <path>.partial, renamed over <path> by commit()
   Mode mode_;
   long file_ = -1;  // hid_t
-  bool committed_ = false;
   // Appendable datasets stay open until commit/destruction so that HDF5's
   // chunk cache keeps a partly filled chunk in memory: reopening per append
   // flushed (deflated) and re-read (inflated) it on every frame.

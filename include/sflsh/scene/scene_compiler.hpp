@@ -25,6 +25,7 @@
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/sim/energies/virtual_coupling.hpp"
 #include "sflsh/sim/grasp_controller.hpp"
+#include "sflsh/sim/avatar_model.hpp"
 #include "sflsh/sim/model.hpp"
 #include "sflsh/sim/state.hpp"
 
@@ -45,6 +46,11 @@ struct CompiledBody {
   MotionClip motion;
   int model_index = 0;
   Isometry placement = Isometry::Identity();  ///< at t = 0: heading about +Y, then offset
+  /// The placement applies (scene bodies). false: the body follows its motion
+  /// as given (one avatar driven by a motion, compile_avatar_motion).
+  bool placed = true;
+  /// Start at rest in the motion's first pose instead of moving with it.
+  bool start_at_rest = false;
   /// Model term indices of its elastic and damping terms: what a stiffness
   /// scale multiplies (model_with_stiffness).
   std::vector<int> stiffness_terms;
@@ -54,7 +60,8 @@ struct CompiledBody {
   /// The motion's pose at t (the rest pose without a motion), placed.
   BodyPose target_pose(double t) const;
   /// Where the body starts: the placed motion at t = 0, moving with the motion
-  /// (and the body's velocity) over the first step of `h` seconds.
+  /// (and the body's velocity) over the first step of `h` seconds, or at rest
+  /// there (start_at_rest).
   BodyState initial_state(double h) const;
 };
 
@@ -103,6 +110,12 @@ struct CompiledTool {
 /// A compiled scene. Its `desc` pointers point into the SceneDescription it
 /// was compiled from, which must outlive it.
 struct CompiledScene {
+  /// What messages call the run: the scene file ("scene" when built in code)
+  /// or, for one avatar driven by a motion, the motion's name.
+  std::string name;
+  /// One avatar driven by a motion (compile_avatar_motion): results name the
+  /// motion and list no bodies, as the one-avatar result file has them.
+  bool one_avatar = false;
   std::shared_ptr<const Model> model;  ///< every body at stiffness scale 1
   State initial;  ///< t = 0; coupled tools' bodies at rest at the origin until their driver starts them
   double h = 0;        ///< s, the step
@@ -118,6 +131,15 @@ struct CompiledScene {
 /// `avatar: default`, a motion that does not load, a dynamic object with the
 /// contact patch, colliding bodies without bone capsules, ...).
 CompiledScene compile_scene(const SceneDescription& scene, const SceneCompileOptions& options = {});
+
+/// One avatar driven by `motion` (`sflsh simulate --avatar --motion`,
+/// run_simulation) as a one-body scene: `scene` holds its one body (name,
+/// bones) and solver (dt, seconds); the model is avatar_model(avatar, sim,
+/// skeleton when sim.bones_dynamic) and the body follows the motion unplaced,
+/// moving with it at t = 0 unless `start_at_rest`. `scene` must outlive the result.
+CompiledScene compile_avatar_motion(const SceneDescription& scene, std::shared_ptr<const Avatar> avatar,
+                                    const MotionClip& motion, const SimulatorOptions& sim,
+                                    const SkeletonTermsOptions& skeleton, bool start_at_rest);
 
 /// `base` with the elastic and damping terms of body i (scene order) scaled by
 /// scales[i] (ScaledTerm, sim/energies/scaled_term.hpp); `base` itself when

@@ -1,15 +1,18 @@
 #pragma once
-// Running a scene file as fast as possible (`sflsh simulate scene.yaml`):
-// a SceneSession (scene_session.hpp: how the scene becomes a model
-// and what its bodies, objects and tools do) stepped to its end, every
-// output frame recorded, and the contact and tool figures gathered. The
-// result holds every body's skin (concatenated,
-// SimulationResult::body_vertex_offsets) and the objects' and tools' poses.
+// The offline run loop, as fast as possible: scene files (`sflsh simulate
+// scene.yaml`) and one avatar driven by a motion (`sflsh simulate --avatar
+// --motion`, run_simulation, a one-body scene) alike. A SceneSession
+// (scene_session.hpp: how the scene becomes a model and what its bodies,
+// objects and tools do) stepped to its end, every output frame recorded, and
+// the contact and tool figures gathered. The result holds every body's skin
+// (concatenated, SimulationResult::body_vertex_offsets) and the objects' and
+// tools' poses.
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_session.hpp"
 #include "sflsh/scene/simulation_run.hpp"
 
 namespace sflsh {
@@ -18,6 +21,21 @@ struct SceneRunOptions {
   bool progress = true;
   /// Root push limit of bodies in body contact, as a fraction of body weight.
   double body_push_limit = 0.25;
+  /// Keep every output frame in the result (memory: ~0.5 MB per frame for a
+  /// 10k-vertex body). Long runs set false and stream with on_frame.
+  bool keep_frames = true;
+  /// Called with every output frame as it is made; may be empty.
+  std::function<void(const FrameData&)> on_frame;
+  /// Called after every step (e.g. the benchmark records u); may be empty.
+  std::function<void(const Simulator&, const StepReport&)> on_step;
+  /// Continue from this checkpoint (sim/state_file.hpp) instead of the
+  /// scene's start: the run goes from the checkpoint's time to the scene's
+  /// end, its frames start at the checkpoint's time. Not with tools.
+  std::string resume;
+  /// Save the final state here (a checkpoint to resume from).
+  std::string checkpoint;
+  /// TEST ONLY: SceneSessionOptions::inject_nan_at_step.
+  long inject_nan_at_step = 0;
 };
 
 /// Contact figures of a run (the largest over all steps).
@@ -58,6 +76,15 @@ struct SceneContactStats {
 /// made so far, marked incomplete) when the state or an energy becomes
 /// non-finite, naming the step, the term and the body.
 SimulationResult run_scene(const SceneDescription& scene, const SceneRunOptions& options = {},
+                           SceneContactStats* stats = nullptr);
+
+/// The run loop of every offline run (scene files and one avatar driven by a
+/// motion, run_simulation): steps `scene` from where it stands (or
+/// options.resume) to its end, an output frame at t = 0 and every
+/// 1/scene().output.fps s (kept, passed to on_frame), the pelvis figures of
+/// the first body, the contact and tool figures into `stats`, and
+/// options.checkpoint at the end. Throws SimulationStopped as run_scene.
+SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& options = {},
                            SceneContactStats* stats = nullptr);
 
 }  // namespace sflsh

@@ -66,6 +66,10 @@ struct SceneSessionOptions {
   /// hold instead of its own pose source (its stream is not opened). Replaying
   /// a recorded session gives bit-identical trajectories.
   std::string replay_dir;
+  /// TEST ONLY (`sflsh simulate --inject-nan-at-step N`): the first body's
+  /// target of step N (1-based) gets a NaN pelvis bone translation, to drive
+  /// the run into the numerical guard. 0 = off.
+  long inject_nan_at_step = 0;
 };
 
 class SceneSession {
@@ -74,6 +78,11 @@ class SceneSession {
   /// stream ports). Throws sflsh::Error naming the scene file and the body,
   /// object or tool on inputs the runtime rejects.
   explicit SceneSession(const SceneDescription& scene, const SceneSessionOptions& options = {});
+  /// One avatar driven by `motion` (run_simulation): a one-body scene of body
+  /// "avatar" compiled by compile_avatar_motion with options.sim,
+  /// options.skeleton and options.start_at_rest, lasting options.seconds (0:
+  /// the motion's duration).
+  SceneSession(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options);
   ~SceneSession();
   SceneSession(const SceneSession&) = delete;
   SceneSession& operator=(const SceneSession&) = delete;
@@ -82,6 +91,8 @@ class SceneSession {
   double dt() const;                ///< s, the solver's step
   double time() const;              ///< s simulated so far
   long steps_done() const;
+  /// What messages call the run: the scene file, or the one avatar's motion.
+  const std::string& name() const;
   /// Scene duration (s): solver.seconds, or the longest body motion.
   double seconds() const;
   /// Steps of the whole scene: max(1, round(seconds / dt)).
@@ -91,6 +102,11 @@ class SceneSession {
   /// steps the model, updates tool states and stream feedback. Throws naming
   /// the body/object/tool and the step when the state becomes non-finite.
   const StepReport& advance();
+  /// Continues from `state` (a checkpoint of this scene's model, sim/state_file.hpp):
+  /// steps_done() becomes its time in steps. Throws naming `where` when its
+  /// time is not a whole number of steps or past the scene's end, or when the
+  /// scene has tools (their grasps and devices are not in a checkpoint).
+  void resume(const State& state, const std::string& where);
   const StepReport& last_report() const;
 
   /// Back to the scene's start (time 0, steps_done() 0): every body, dynamic
@@ -161,10 +177,13 @@ class SceneSession {
   SimulationResult result_header() const;
   /// Current poses of the result_header() objects, in its order (world).
   std::vector<Isometry> object_poses() const;
-  /// Appends the current state as a frame of `result` (made by result_header();
-  /// `step_ms`: the mean step time since the previous frame): skins, joints,
-  /// object poses, each tool's pose, closure, force and torque; and sets
-  /// result.tool_events to the events so far.
+  /// The current state as an output frame (`step_ms`: the mean step time
+  /// since the previous frame): every body's skin, displacement, joints and z,
+  /// the first body's target pelvis (G_0 J̄_0 of its target bones), object
+  /// poses, each tool's pose, closure, force and torque.
+  FrameData frame(double step_ms) const;
+  /// Appends the current state as a frame of `result` (made by result_header()):
+  /// frame(step_ms) added with add_frame(); sets result.tool_events to the events so far.
   void record_frame(SimulationResult& result, double step_ms) const;
 
   /// The simulator: the same object for the session's life (references stay

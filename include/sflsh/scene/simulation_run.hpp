@@ -130,13 +130,16 @@ struct SimulationResult {
   void add_step_times(const StepReport& report);
   /// Records a step ending at time t (s): the step_* series, its times and outcome counts.
   void add_step(double t, const StepReport& report);
+  /// Keeps an output frame: the frame_* series, each object's pose and each
+  /// tool's frame (num_frames and the pelvis figures are counted apart).
+  void add_frame(FrameData frame);
   /// Median / 95th percentile step wall time (ms).
   double median_step_ms() const;
   double p95_step_ms() const;
   std::string describe() const;
 };
 
-/// Thrown by run_simulation when the numerical guard trips: what() names the
+/// Thrown by the run loop (run_scene, run_simulation) when the numerical guard trips: what() names the
 /// step, the term and the body; `partial` holds what was made before the
 /// step (frames already passed to on_frame, steps), marked incomplete.
 class SimulationStopped : public Error {
@@ -150,6 +153,8 @@ class SimulationStopped : public Error {
 /// RunOptions::start_at_rest; soft tissue undeformed). Every output frame is passed to
 /// `on_frame` (if given) as it is made. Throws SimulationStopped if the state
 /// or an energy becomes non-finite (no frame of that step is made).
+/// The avatar and motion are a one-body scene (SceneSession's one-avatar
+/// constructor) run by the scene files' loop, run_scene (scene_run.hpp).
 SimulationResult run_simulation(std::shared_ptr<const Avatar> avatar, const MotionClip& motion, const RunOptions& options,
                                 const std::function<void(const FrameData&)>& on_frame = {});
 

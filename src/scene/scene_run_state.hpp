@@ -1,7 +1,7 @@
 #pragma once
-// SceneSession's state, shared by its two source files: scene_session.cpp
-// (building, stepping, tools, stiffness) and scene_session_result.cpp (what
-// it writes to a result).
+// SceneSession's state, shared by the files that implement it: scene_run.cpp
+// (building, stepping, stiffness, resuming), scene_frames.cpp (the result's
+// header and frames, the bodies' surfaces) and tool_driver.cpp (its tools).
 #include <memory>
 #include <vector>
 
@@ -23,6 +23,14 @@ struct SceneSession::Impl {
   State initial;               ///< the state at t = 0 with the tools started (reset)
   std::vector<double> stiffness;  ///< per body (scene order): its stiffness scale
   long k = 0;                  ///< steps done
+  long first_k = 0;            ///< steps done when the run started (0, or a checkpoint's)
+
+  /// Starts the compiled scene: its tools' drivers, the simulator at the initial state.
+  void start();
+
+  /// The result's object poses at time t (world): the objects, the tools with
+  /// a shape, then every tool's jaws (SceneSession::result_header's order).
+  std::vector<Isometry> object_poses(double t) const;
 
   /// An object's pose at time t: its description's, or its rigid body's (dynamic).
   Isometry object_pose(const CompiledObject& o, double t) const {
