@@ -1,0 +1,98 @@
+// The patch's displacement δu minimized at the body's configuration:
+// Newton on δu with q fixed, warm-started from the last linearization
+// (contact_patch.hpp, "Condensation").
+#include <cmath>
+#include <limits>
+
+#include "sflsh/sim/energies/contact_patch.hpp"
+#include "sim/energies/contact_patch_cache.hpp"
+
+namespace sflsh {
+
+using contact_patch_detail::patch_cache;
+using contact_patch_detail::PatchCache;
+
+namespace {
+bool same_configuration(const Configuration& a, const Configuration& b) {
+  if (a.z.size() != b.z.size() || a.bones.size() != b.bones.size() || a.z != b.z) return false;
+  for (size_t j = 0; j < a.bones.size(); ++j)
+    if (a.bones[j].matrix() != b.bones[j].matrix()) return false;
+  return true;
+}
+}  // namespace
+
+VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
+  PatchCache& c = patch_cache(ctx, name());
+  if (c.du.size() == 0) return c.du;
+  // The integrator evaluates the final configuration several times (trial,
+  // report): the minimizer is kept.
+  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+  if (c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix()) return c.du;
+  VecX du = c.du;
+  // Warm start from the last linearization: the back-substitution of the
+  // bordered Newton system for the change of z (the bones' change is left out).
+  if (c.linearized && c.z_lin.size() == q.z.size()) du = c.du_lin - c.Hpp_llt.solve(c.Hpz * (q.z - c.z_lin));
+  Evaluation ev, trial;
+  ++c.minimizations;
+  EvaluationMode exact, energy_only;
+  exact.project = false;
+  exact.subspace_energy = false;
+  energy_only.p_derivatives = false;
+  energy_only.subspace_energy = false;
+  // Newton on δu: the exact element Hessians (quadratic convergence) unless
+  // compression makes them indefinite, then their PSD majorizers; Armijo
+  // backtracking; stops when the Newton decrement −gᵀs falls below
+  // inner_tolerance × |Φ| (or the gradient vanishes).
+  // A start that inverts a tet (the warm start, or the subspace itself at
+  // this q): the last minimizer, then no patch displacement; if every start
+  // is inadmissible the term's energy is +inf there and the step backtracks.
+  for (int it = 0; it < options_.max_inner_iterations; ++it) {
+    double E0 = evaluate_patch(ctx, q, du, exact, ev);
+    if (it == 0 && !std::isfinite(E0)) {
+      du = c.du;
+      E0 = evaluate_patch(ctx, q, du, exact, ev);
+      if (!std::isfinite(E0)) {
+        du.setZero();
+        E0 = evaluate_patch(ctx, q, du, exact, ev);
+      }
+    }
+    if (!std::isfinite(E0)) break;
+    if (ev.gp.norm() < 1e-12) break;
+    Eigen::LLT<MatX> llt(ev.Hpp);
+    if (llt.info() != Eigen::Success) {
+      EvaluationMode projected = exact;
+      projected.project = true;
+      evaluate_patch(ctx, q, du, projected, ev);
+      llt.compute(ev.Hpp);
+      if (llt.info() != Eigen::Success) {
+        // PSD by construction and PD with mass: only a degenerate tet gets here.
+        ev.Hpp.diagonal() *= 1.0 + 1e-8;
+        llt.compute(ev.Hpp);
+        require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+      }
+    }
+    const VecX step = llt.solve(-ev.gp);
+    const double slope = ev.gp.dot(step);
+    if (-slope <= options_.inner_tolerance * std::max(std::abs(E0), 1e-12)) break;
+    double alpha = 1;
+    bool ok = false;
+    for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
+      const double E1 = evaluate_patch(ctx, q, du + alpha * step, energy_only, trial);
+      if (std::isfinite(E1) && E1 <= E0 + 1e-4 * alpha * slope + 1e-15 * std::abs(E0)) {
+        ok = true;
+        break;
+      }
+    }
+    if (!ok) break;
+    du += alpha * step;
+    ++c.inner_iterations;
+    if (alpha * step.cwiseAbs().maxCoeff() < 1e-13) break;
+  }
+  c.du = du;
+  c.solved = true;
+  c.q_solved = q;
+  c.object_solved = object;
+  return du;
+}
+
+}  // namespace sflsh
