@@ -436,12 +436,7 @@ TEST(CapsuleContact, GradientHessianAndMomentumBetweenTwoBodies) {
   const VecX j = d.grad / (k * gap);
   EXPECT_LT((d.hess - k * j * j.transpose()).norm(), 1e-3 * d.hess.norm());
   // Equal and opposite: translational and rotational gradients sum to zero.
-  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
-  for (const Bound& bd : bodies)
-    for (int i = 0; i < 24; ++i) {
-      torque += d.grad.segment<3>(bd.layout.bone_offset(i));
-      force += d.grad.segment<3>(bd.layout.bone_offset(i) + 3);
-    }
+  const auto [force, torque] = summed_bone_gradient(d.grad, bodies);
   EXPECT_LT(force.norm(), 1e-12 * d.grad.norm());
   EXPECT_LT(torque.norm(), 1e-12 * d.grad.norm());
 }

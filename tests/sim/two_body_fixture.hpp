@@ -8,6 +8,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sflsh/sim/energy_term.hpp"
@@ -126,6 +127,19 @@ inline VecX fd_gradient(const EnergyTerm& term, const StepContext& ctx, const st
     g[i] = (energy_at(term, ctx, bodies, d) - energy_at(term, ctx, bodies, -d)) / (2 * eps);
   }
   return g;
+}
+
+/// The gradient's translation parts (a force, first) and rotation parts (a
+/// torque about the origin, second) summed over every bone of every body:
+/// both vanish when the term's forces are internal (equal and opposite, collinear).
+inline std::pair<Vec3, Vec3> summed_bone_gradient(const VecX& grad, const std::vector<Bound>& bodies) {
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+  for (const Bound& bd : bodies)
+    for (int i = 0; i < 24; ++i) {
+      torque += grad.segment<3>(bd.layout.bone_offset(i));
+      force += grad.segment<3>(bd.layout.bone_offset(i) + 3);
+    }
+  return {force, torque};
 }
 
 inline double rel(const VecX& a, const VecX& b) { return (a - b).norm() / std::max(1e-12, b.norm()); }
