@@ -37,8 +37,9 @@
 // deeper than `max_depth` behind b's skin at time t (the bone capsules' cores
 // keep bodies from passing through).
 //
-// Cost: samples × (DoFs a sample touches)²; a 1 cm spacing samples a trunk
-// against trunk contact (≈ 0.03 m²) with ≈ 300 samples per side.
+// Cost: per evaluation, the pairs' gaps plus (DoFs a sample touches)² for each
+// sample in contact; the broad phase once per step. Two default avatars
+// walking into each other form 1,000–3,000 pairs, a few hundred in contact.
 #include <memory>
 #include <string>
 #include <vector>
