@@ -39,7 +39,7 @@
 //
 // Cost: per evaluation, the pairs' gaps plus (DoFs a sample touches)² for each
 // sample in contact; the broad phase once per step. Two default avatars
-// walking into each other form 1,000–3,000 pairs, a few hundred in contact.
+// walking into each other form up to ~18,000 pairs (median ~9,000), up to ~740 in contact.
 #include <memory>
 #include <string>
 #include <vector>
