@@ -57,5 +57,5 @@ echo "Done. Outputs in $(cd "$OUT" && pwd):"
 ls -1 "$OUT" | sed 's/^/  /'
 echo "Open the .obj/.ply/.glb files in Blender, MeshLab or any glTF viewer; body.png is the body,"
 echo "jump.png the simulation (skin coloured by soft displacement), jump.h5 the result cache,"
-echo "jump.pc2 + jump_rest.obj the animation for Blender (README: 'Opening results in Blender');"
+echo "jump.pc2 + jump_rest.obj the animation for Blender (README: File formats, 'Blender');"
 echo "ball_at_belly.png/.glb the contact scene (the ball is a separate node in the glTF)."
