@@ -1,6 +1,7 @@
 #include "sflsh/sim/energies/skin_contact.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,10 @@ constexpr double kMotionFactor = 1.5;
 
 struct PairCache : TermCache {
   std::vector<SkinContactTerm::Pair> pairs;
+  // The vertices the pairs use, per skin, and each vertex's place in that list
+  // (−1: unused): an evaluation poses each of them once.
+  std::vector<int> used[2];
+  std::vector<int> slot[2];
   // Scratch of compute(): one sample's row nᵀ(J_a − J_b) over the local DoFs.
   VecX row;
   std::vector<int> touched;
@@ -69,15 +74,27 @@ SkinContactTerm::SkinContactTerm(const Avatar& a, const Avatar& b, const SkinCon
   skins_[1] = make_skin(b, o.max_handles);
 }
 
-double SkinContactTerm::gap(const Pair& p, const Configuration* const q[2]) const {
-  const Skin& from = skins_[p.side];
-  const Skin& to = skins_[1 - p.side];
-  Vec3 x = Vec3::Zero(), y = Vec3::Zero();
-  for (int i = 0; i < 3; ++i) {
-    x += p.lambda[i] * from.vertices.world_point(from.faces(p.face, i), *q[p.side]);
-    y += p.mu[i] * to.vertices.world_point(to.faces(p.other_face, i), *q[1 - p.side]);
+/// World positions of the vertices the pairs use (row k: used[side][k]) at q[0], q[1].
+std::array<Points, 2> SkinContactTerm::posed_vertices(const TermCache& cache, const Configuration* const q[2]) const {
+  const auto& c = static_cast<const PairCache&>(cache);
+  std::array<Points, 2> x;
+  for (int side = 0; side < 2; ++side) {
+    x[side].resize(c.used[side].size(), 3);
+    for (size_t k = 0; k < c.used[side].size(); ++k)
+      x[side].row(k) = skins_[side].vertices.world_point(c.used[side][k], *q[side]).transpose();
   }
-  return p.normal.dot(x - y);
+  return x;
+}
+
+double SkinContactTerm::gap(const Pair& p, const TermCache& cache, const std::array<Points, 2>& x) const {
+  const auto& c = static_cast<const PairCache&>(cache);
+  const int from = p.side, to = 1 - p.side;
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    a += p.lambda[i] * x[from].row(c.slot[from][skins_[from].faces(p.face, i)]).transpose();
+    b += p.mu[i] * x[to].row(c.slot[to][skins_[to].faces(p.other_face, i)]).transpose();
+  }
+  return p.normal.dot(a - b);
 }
 
 std::unique_ptr<TermCache> SkinContactTerm::make_cache() const { return std::make_unique<PairCache>(); }
@@ -182,6 +199,7 @@ void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_
 void SkinContactTerm::begin_step(const StepContext& ctx) const {
   auto& c = static_cast<PairCache&>(*ctx.cache);
   c.pairs.clear();
+  for (int side = 0; side < 2; ++side) c.used[side].clear();
   require(ctx.bound.size() == 2u, name(), ": bound to ", ctx.bound.size(), " bodies, expected 2");
   Points x[2];
   VecX motion[2];
@@ -197,6 +215,17 @@ void SkinContactTerm::begin_step(const StepContext& ctx) const {
   if (!geometry::Aabb::of_points(x[0]).inflated(reach).intersects(geometry::Aabb::of_points(x[1]))) return;
   collect_pairs(0, skins_[0], x[0], motion[0], skins_[1], x[1], motion[1], c.pairs);
   collect_pairs(1, skins_[1], x[1], motion[1], skins_[0], x[0], motion[0], c.pairs);
+  for (int side = 0; side < 2; ++side) c.slot[side].assign(skins_[side].vertices.size(), -1);
+  auto use = [&](int side, int vertex) {
+    if (c.slot[side][vertex] >= 0) return;
+    c.slot[side][vertex] = int(c.used[side].size());
+    c.used[side].push_back(vertex);
+  };
+  for (const Pair& p : c.pairs)
+    for (int i = 0; i < 3; ++i) {
+      use(p.side, skins_[p.side].faces(p.face, i));
+      use(1 - p.side, skins_[1 - p.side].faces(p.other_face, i));
+    }
 }
 
 bool SkinContactTerm::active(const StepContext& ctx) const {
@@ -206,6 +235,7 @@ bool SkinContactTerm::active(const StepContext& ctx) const {
 double SkinContactTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   auto& c = static_cast<PairCache&>(*ctx.cache);
   const Configuration* qs[2] = {&q, ctx.bound[1].q};
+  const std::array<Points, 2> x = posed_vertices(c, qs);
   const DofLayout* layouts[2] = {&ctx.bound[0].layout, &ctx.bound[1].layout};
   const double half_kappa = 0.5 * options_.pressure_stiffness;
   const int n_local = layouts[1]->end();
@@ -219,7 +249,7 @@ double SkinContactTerm::compute(const StepContext& ctx, const Configuration& q, 
   double E = 0;
   for (const Pair& p : c.pairs) {
     const int from = p.side;
-    const double g = gap(p, qs);
+    const double g = gap(p, c, x);
     if (!(g < 0)) continue;
     const double k = half_kappa * p.area;
     E += 0.5 * k * g * g;
@@ -260,13 +290,14 @@ double SkinContactTerm::compute(const StepContext& ctx, const Configuration& q, 
 std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const Configuration& q) const {
   const auto& c = static_cast<PairCache&>(*ctx.cache);
   const Configuration* qs[2] = {&q, ctx.bound[1].q};
+  const std::array<Points, 2> x = posed_vertices(c, qs);
   const double half_kappa = 0.5 * options_.pressure_stiffness;
   Vec3 force = Vec3::Zero();
   int active = 0;
   double worst = 0, area = 0;
   for (const Pair& p : c.pairs) {
     const int from = p.side;
-    const double g = gap(p, qs);
+    const double g = gap(p, c, x);
     if (!(g < 0)) continue;
     // On the sample's body: −κ/2 a g n; a is that body on side 0, the other one on side 1.
     const Vec3 on_sample = -half_kappa * p.area * g * p.normal;

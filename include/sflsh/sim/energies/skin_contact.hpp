@@ -40,6 +40,7 @@
 // Cost: per evaluation, the pairs' gaps plus (DoFs a sample touches)² for each
 // sample in contact; the broad phase once per step. Two default avatars
 // walking into each other form up to ~18,000 pairs (median ~9,000), up to ~740 in contact.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,8 +103,10 @@ class SkinContactTerm : public EnergyTerm {
   /// skins at time t and how far each vertex moved over the last step (m).
   void collect_pairs(int side, const Skin& from, const Points& x_from, const VecX& m_from, const Skin& to,
                      const Points& x_to, const VecX& m_to, std::vector<Pair>& out) const;
-  /// The pair's gap g (m) at the two bodies' configurations q[0], q[1].
-  double gap(const Pair& p, const Configuration* const q[2]) const;
+  /// World positions of the vertices the step's pairs use (the cache's list per skin) at q[0], q[1].
+  std::array<Points, 2> posed_vertices(const TermCache& cache, const Configuration* const q[2]) const;
+  /// The pair's gap g (m), given posed_vertices().
+  double gap(const Pair& p, const TermCache& cache, const std::array<Points, 2>& x) const;
   Skin skins_[2];
   SkinContactOptions options_;
 };
