@@ -49,6 +49,7 @@ class CapsuleContactTerm : public EnergyTerm {
   /// "max_overlap" (1, m) at the final q.
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
+  const CapsuleContactOptions& options() const { return options_; }
   /// Candidate pairs (capsule index in a, in b).
   const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
   /// Largest capsule overlap (m, ≥ 0) of the pairs at bone transforms `bones_a`, `bones_b`.
