@@ -106,6 +106,14 @@ void solve_in_place(MatX& H, const VecX& g, double eps, VecX& delta, double* shi
        "; a DoF without any energy or a NaN in a term?");
 }
 
+/// Σ of `per_term` over the active terms the nonlinearity check leaves out.
+double unchecked_energy(const StepSystem& sys, const std::vector<double>& per_term) {
+  double E = 0;
+  for (size_t i = 0; i < sys.terms.size() && i < per_term.size(); ++i)
+    if (sys.terms[i].active && !sys.terms[i].term->in_nonlinearity_check()) E += per_term[i];
+  return E;
+}
+
 /// Whether every DoF of the step is a body's soft tissue (z): no dynamic bone, rigid body or tool.
 bool only_soft_dofs(const StepSystem& sys) {
   int soft = 0;
@@ -125,11 +133,28 @@ TermPlacement TermPlacement::from_ranges(std::vector<std::pair<int, int>> ranges
   return p;
 }
 
-double total_energy(StepSystem& sys, const std::vector<Configuration>& q, VecX* grad, MatX* hess,
-                    std::vector<double>* per_term, std::vector<double>* term_ms) {
+namespace {
+
+/// What the terms left out of the nonlinearity check (EnergyTerm::
+/// in_nonlinearity_check) add to an assembly: their gradient and Hessian,
+/// also contained in the totals.
+struct UncheckedPart {
+  VecX g;
+  MatX H;
+};
+
+/// total_energy; with `unchecked` (and grad, hess), the unchecked terms'
+/// derivatives are also kept apart there.
+double assemble(StepSystem& sys, const std::vector<Configuration>& q, VecX* grad, MatX* hess,
+                std::vector<double>* per_term, std::vector<double>* term_ms, UncheckedPart* unchecked) {
   const int n = sys.size;
   if (grad) grad->setZero(n);
   if (hess) hess->setZero(n, n);
+  const bool split = unchecked && grad && hess;
+  if (split) {
+    unchecked->g.setZero(n);
+    unchecked->H.setZero(n, n);
+  }
   if (per_term) per_term->clear();
   if (term_ms) term_ms->resize(sys.terms.size(), 0.0);
   double E = 0;
@@ -140,12 +165,25 @@ double total_energy(StepSystem& sys, const std::vector<Configuration>& q, VecX* 
       continue;
     }
     Timer timer;
-    const double e = evaluate_term(t, q, grad, hess, sys.scratch_grad, sys.scratch_hess);
+    const bool apart = split && !t.term->in_nonlinearity_check();
+    const double e = evaluate_term(t, q, apart ? &unchecked->g : grad, apart ? &unchecked->H : hess,
+                                   sys.scratch_grad, sys.scratch_hess);
     if (term_ms) (*term_ms)[i] += timer.ms();
     if (per_term) per_term->push_back(e);
     E += e;
   }
+  if (split) {
+    *grad += unchecked->g;
+    *hess += unchecked->H;
+  }
   return E;
+}
+
+}  // namespace
+
+double total_energy(StepSystem& sys, const std::vector<Configuration>& q, VecX* grad, MatX* hess,
+                    std::vector<double>* per_term, std::vector<double>* term_ms) {
+  return assemble(sys, q, grad, hess, per_term, term_ms, nullptr);
 }
 
 namespace {
@@ -218,8 +256,7 @@ bool search_step(StepSystem& sys, const std::vector<Configuration>& q, VecX& del
                  double& E_trial) {
   for (int halving = 0; halving <= kMaxHalvings; ++halving, c.alpha *= 0.5) {
     trial = retract_all(q, c.alpha * delta, sys.bodies);
-    const double E1 = total_energy(sys, trial, last ? &rec.g_final : nullptr, nullptr, last ? &rec.per_term : nullptr,
-                                   &rec.term_ms);
+    const double E1 = total_energy(sys, trial, last ? &rec.g_final : nullptr, nullptr, &rec.per_term, &rec.term_ms);
     rec.final_valid = last;
     const bool admissible = std::isfinite(E1);
     if (line_search ? (admissible && E1 <= E0 + kArmijo * c.alpha * c.slope) : admissible) {
@@ -285,10 +322,16 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
   TrialRecord rec;
   const double nonlinearity_tolerance = o.nonlinearity_tolerance.value_or(
       only_soft_dofs(sys) ? kAutoNonlinearityTolerance : 0.0);
+  bool any_unchecked = false;
+  for (const SystemTerm& t : sys.terms) any_unchecked |= t.active && !t.term->in_nonlinearity_check();
+  UncheckedPart unchecked;
+  std::vector<double> per_term0;
   int planned = o.iterations;  // grows while the last iteration is damped (iterations_after_damping)
   for (int it = 0; it < planned; ++it) {
     Timer ta;
-    const double E0 = total_energy(sys, q, &g, &H, nullptr, &rec.term_ms);
+    // The nonlinearity check may follow this iteration: keep the unchecked terms' part apart.
+    const bool split = any_unchecked && nonlinearity_tolerance > 0 && it + 1 == planned && it < o.iterations;
+    const double E0 = assemble(sys, q, &g, &H, split ? &per_term0 : nullptr, &rec.term_ms, split ? &unchecked : nullptr);
     rep.ms_assemble += ta.ms();
     require(std::isfinite(E0) && g.allFinite(), "newton_minimize: energy or gradient is not finite at the start of "
             "iteration ", it, " (E = ", E0, "); the configuration is inadmissible");
@@ -347,9 +390,20 @@ StepReport newton_minimize(StepSystem& sys, std::vector<Configuration>& q, const
       ++rep.iterations_after_damping;
     } else if (outcome == StepOutcome::Accepted && it + 1 == planned && !added && nonlinearity_tolerance > 0 &&
                -slope > 1e-12 * std::max(1.0, std::abs(E0))) {
-      // The full Newton step predicts a decrease of ½ δᵀHδ = −½ gᵀδ.
-      const double rho = (E0 - E_trial) / (-0.5 * slope);
-      if (std::abs(rho - 1.0) > nonlinearity_tolerance) {
+      // The full Newton step predicts a decrease of ½ δᵀHδ = −½ gᵀδ. With
+      // contact terms (left out of the check), the other terms' change is
+      // compared with their own model, −g_cᵀδ − ½ δᵀH_cδ (g_c = g − g_u,
+      // H_c = H − H_u, δᵀHδ = −gᵀδ), still as a share of the whole step's
+      // predicted decrease.
+      const double predicted = -0.5 * slope;
+      double departure = (E0 - E_trial) - predicted;
+      if (split) {
+        const VecX& d = delta;
+        const double predicted_checked = predicted + unchecked.g.dot(d) + 0.5 * d.dot(unchecked.H * d);
+        const double actual_checked = (E0 - unchecked_energy(sys, per_term0)) - (E_trial - unchecked_energy(sys, rec.per_term));
+        departure = actual_checked - predicted_checked;
+      }
+      if (std::abs(departure / predicted) > nonlinearity_tolerance) {
         ++planned;
         ++rep.iterations_for_nonlinearity;
       }

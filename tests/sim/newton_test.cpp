@@ -9,6 +9,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/timer.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
+#include "sflsh/sim/energies/scaled_term.hpp"
 #include "sflsh/sim/energies/gravity.hpp"
 #include "sflsh/sim/energies/inertia.hpp"
 #include "sflsh/sim/simulator.hpp"
@@ -213,7 +214,9 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
 /// E(z) = Σ_i ½ a z_i² + ¼ b z_i⁴ − f z_i on the soft DoFs alone.
 struct QuarticTerm : EnergyTerm {
   double a = 1, b = 0, f = 1;
+  bool checked = true;  ///< in_nonlinearity_check (false: as a contact term)
   std::string name() const override { return "quartic"; }
+  bool in_nonlinearity_check() const override { return checked; }
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override {
     const int z0 = ctx.layout.z_offset();
     double E = 0;
@@ -259,6 +262,44 @@ TEST(Newton, AFullStepFarFromItsQuadraticModelGetsOneMoreIteration) {
   }
   o.nonlinearity_tolerance = -1;
   EXPECT_THROW(newton_minimize({&term}, ctx, q, o), Error);
+}
+
+/// Contact terms are left out of the check: a quadratic Q = ½z² − z and a
+/// quartic U = ½z² + z⁴. From z = 0 the step is δ = 1/2 (g = −1, H = 2) and
+/// the model predicts a decrease of ¼ per DoF. Q falls by 3/8, exactly its own
+/// model's −g_Qδ − ½H_Qδ² = ½ − ⅛; U rises by ⅛ + 1/16 against a model of ⅛:
+/// ρ = 0.75 (by hand). Counted, U adds an iteration; as a contact term, none
+/// (z = 1/2 exactly). The other way round (Q quartic, U = ½z² left out) Q
+/// departs from its model by 1/16 = ¼ of the predicted decrease: added.
+TEST(Newton, TermsLeftOutOfTheNonlinearityCheckDoNotAddIterations) {
+  StepContext ctx;
+  ctx.layout.bones_dynamic = false;
+  ctx.layout.num_bones = 0;
+  ctx.layout.num_reduced = 3;
+  NewtonOptions o;
+  o.max_z_step = 0;
+  o.nonlinearity_tolerance = 0.05;
+  for (const bool left_out : {false, true}) {
+    QuarticTerm quadratic, quartic;
+    quartic.f = 0;
+    quartic.b = 4;
+    quartic.checked = !left_out;
+    const auto scaled = std::make_shared<const QuarticTerm>(quartic);
+    ScaledTerm unit(scaled, 1.0);  // the wrapper forwards in_nonlinearity_check
+    EXPECT_EQ(unit.in_nonlinearity_check(), !left_out);
+    Configuration q;
+    q.z = VecX::Zero(3);
+    const StepReport rep = newton_minimize({&quadratic, &unit}, ctx, q, o);
+    EXPECT_EQ(rep.iterations_for_nonlinearity, left_out ? 0 : 1) << "left out " << left_out;
+    if (left_out) EXPECT_NEAR(q.z[1], 0.5, 1e-15);
+  }
+  QuarticTerm nonlinear, left_out;
+  nonlinear.b = 4;
+  left_out.f = 0;
+  left_out.checked = false;
+  Configuration q;
+  q.z = VecX::Zero(3);
+  EXPECT_EQ(newton_minimize({&nonlinear, &left_out}, ctx, q, o).iterations_for_nonlinearity, 1);
 }
 
 /// Unset, the tolerance is kAutoNonlinearityTolerance (0.05) when the step's DoFs are all soft

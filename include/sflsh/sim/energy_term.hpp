@@ -129,6 +129,12 @@ class EnergyTerm {
   /// Whether the term takes part in this step (after begin_step; e.g. a contact
   /// term with nothing near, an anchor not grasping). Inactive terms cost nothing.
   virtual bool active(const StepContext& ctx) const { return true; }
+  /// Whether the Newton solver's nonlinearity check (NewtonOptions::
+  /// nonlinearity_tolerance) measures this term. Contact terms answer false:
+  /// a penalty whose samples enter and leave contact within a step departs
+  /// from its quadratic model whatever the flesh does, and a second Newton
+  /// iteration does not change what it gives (a probe's force, contact figures).
+  virtual bool in_nonlinearity_check() const { return true; }
   /// Energy at q (J), q = the first bound body's configuration. If `grad` is
   /// non-null, adds ∂E/∂δ (ctx.layout's local ordering); if `hess` is non-null,
   /// adds a PSD approximation of ∂²E/∂δ² (dense, local, square). Returns

@@ -252,6 +252,50 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
     }
 }
 
+// Σ_t (1 − α) κ_t V_t (Wᵀ b_t)(Wᵀ b_t)ᵀ over the patch tets (b_t the tet's
+// volume-change gradient, κ_t = vᵀH₂v/9): columns over the handles the
+// tets' Simulated nodes touch, then one rank update.
+void ContactPatchTerm::prepare_bulk_hessian(TermCache& cache) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  if (dilatation_cell_.size() == 0 || c.tets.empty()) {
+    c.bulk_handles.clear();
+    c.bulk_hessian.resize(0, 0);
+    c.bulk_tets.clear();
+    return;
+  }
+  if (c.tets == c.bulk_tets) return;
+  const Avatar& a = *avatar_;
+  std::vector<int> index(size_t(a.num_handles()), -1);  // handle → compressed index
+  std::vector<std::pair<int, Vec3>> entries;
+  std::vector<int> first{0};
+  c.bulk_handles.clear();
+  Vec9 v = Vec9::Zero();
+  v[0] = v[4] = v[8] = 1.0;
+  for (size_t ti = 0; ti < c.tets.size(); ++ti) {
+    const int t = c.tets[ti];
+    if (dilatation_cell_[t] < 0) continue;
+    const double kappa = v.dot(c.tet_H2[ti] * v) / 9.0;
+    const double scale = std::sqrt((1.0 - kPerTetVolumeShare) * kappa * tet_volume_[t]);
+    for (int k = 0; k < 4; ++k) {
+      const int n = a.tet.elements(t, k);
+      if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
+        int& h = index[size_t(it.col())];
+        if (h < 0) h = int(c.bulk_handles.size()), c.bulk_handles.push_back(int(it.col()));
+        entries.emplace_back(h, scale * it.value() * grads_[t].row(k).transpose());
+      }
+    }
+    first.push_back(int(entries.size()));
+  }
+  MatX C = MatX::Zero(3 * long(c.bulk_handles.size()), long(first.size()) - 1);
+  for (size_t e = 0; e + 1 < first.size(); ++e)
+    for (int i = first[e]; i < first[e + 1]; ++i) C.block<3, 1>(3 * entries[size_t(i)].first, long(e)) += entries[size_t(i)].second;
+  c.bulk_hessian = MatX::Zero(C.rows(), C.rows());
+  c.bulk_hessian.selfadjointView<Eigen::Lower>().rankUpdate(C);
+  c.bulk_hessian.triangularView<Eigen::StrictlyUpper>() = c.bulk_hessian.transpose();
+  c.bulk_tets = c.tets;
+}
+
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   PatchCache& c = patch_cache(ctx, name());
   // The displacement fixed at the end of the last step becomes the one at t.
@@ -259,6 +303,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     PatchHistory& h = it->second;
     h.d_prev = h.d_t;
     h.d_t = h.d_next;
+    h.du_prev = h.du;
     h.du = h.du_next;
     const double rel = options_.release_displacement;
     if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel)
@@ -329,11 +374,13 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   collect_candidate_faces(c, near);
   select_patch_nodes(c, near, near_phi);
   prepare_patch_tets(c);
+  prepare_bulk_hessian(c);
   // Predictions and the warm start.
   const size_t P = c.nodes.size();
   c.x_star.assign(P, Vec3::Zero());
   c.d_pred.assign(P, Vec3::Zero());
   c.du = VecX::Zero(3 * P);
+  c.du_predicted = VecX::Zero(3 * P);
   c.inner_iterations = c.minimizations = 0;
   c.solved = c.linearized = false;
   for (size_t i = 0; i < P; ++i) {
@@ -344,6 +391,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     if (h == c.history.end()) continue;
     c.d_pred[i] = 2 * h->second.d_t - h->second.d_prev;
     c.du.segment<3>(3 * i) = h->second.du;
+    c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev;
   }
   c.samples_in_patch.clear();
   c.sample_x_star.clear();

@@ -29,7 +29,8 @@ struct ContactPatchTerm::Evaluation {
 namespace contact_patch_detail {
 
 struct PatchHistory {
-  Vec3 du = Vec3::Zero();       // unposed displacement at t (warm start)
+  Vec3 du = Vec3::Zero();       // unposed displacement at t (the fallback start)
+  Vec3 du_prev = Vec3::Zero();  // at t − h
   Vec3 d_t = Vec3::Zero();      // world offset A δu at t
   Vec3 d_prev = Vec3::Zero();   // at t − h
   Vec3 du_next = Vec3::Zero();  // fixed by report() for t + h
@@ -56,10 +57,16 @@ struct PatchCache : TermCache {
   std::vector<int> cross_first, cross_slot;
   std::vector<std::array<int, 16>> tet_cross;
   std::vector<Mat9> tet_H2;
+  // The bulk share mean dilatation leaves out of Φ_zz (contact_patch_evaluation.cpp,
+  // elasticity) over the handles the patch tets touch: constant for a set of tets.
+  std::vector<int> bulk_handles;
+  MatX bulk_hessian;
+  std::vector<int> bulk_tets;  // the tets it was computed for
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
   std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node
   std::vector<Vec3> sample_x_star;             // their predictions
   VecX du;                                     // last minimizer (3 per patch node)
+  VecX du_predicted;                           // the step's first start: 2 δu(t) − δu(t − h)
   int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
   // The configuration `du` minimizes Φ at (skipped when asked again), and the
   // linearization of the last Hessian evaluation: δu(z) ≈ du_lin − Φ_pp⁻¹ Φ_pz (z − z_lin).

@@ -167,8 +167,8 @@ ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, con
 // (Wᵀ b_t)(Wᵀ b_t)ᵀ with b_t the tet's volume-change gradient (κ_t = vᵀH₂v/9,
 // the rank-one bulk part of the material's small-strain Hessian): a PSD
 // Gauss–Newton part of Φ_zz that the one Newton step needs (without it the
-// step overshoots where the patch is). Collected as columns over the
-// handles the patch's tets touch, then one rank update.
+// step overshoots where the patch is). It depends on the patch's tets alone
+// (prepare_bulk_hessian).
 double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Configuration& q, const VecX& du,
                                               const EvaluationMode& mode, Evaluation& out) const {
   const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
@@ -189,11 +189,6 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   // taken through W once per node after the loop.
   std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());
   std::vector<Mat3> node_cross(q_hessian ? c.cross_slot.size() : 0, Mat3::Zero());  // per (node, slot) pair
-  const bool bulk_hessian = q_hessian && dilatation_cell_.size() > 0;
-  std::vector<int> bulk_index(bulk_hessian ? size_t(a.num_handles()) : 0, -1);  // handle → compressed index
-  std::vector<int> bulk_handles;
-  std::vector<std::pair<int, Vec3>> bulk_entries;
-  std::vector<int> bulk_first{0};
   double E = 0;
   for (size_t ti = 0; ti < c.tets.size(); ++ti) {
     const int t = c.tets[ti];
@@ -226,22 +221,6 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
     // Only the Hessian is approximated: the gradient and the energy are exact.
     ElementBlocks K0;
     if (q_hessian) K0 = element_blocks(grads_[t], V, H0);
-    if (bulk_hessian && dilatation_cell_[t] >= 0) {
-      Vec9 v = Vec9::Zero();
-      v[0] = v[4] = v[8] = 1.0;
-      const double kappa = v.dot(H2 * v) / 9.0;
-      const double scale = std::sqrt((1.0 - kPerTetVolumeShare) * kappa * V);
-      for (int k = 0; k < 4; ++k) {
-        const int n = a.tet.elements(t, k);
-        if (!simulated(n)) continue;
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) {
-          int& h = bulk_index[size_t(it.col())];
-          if (h < 0) h = int(bulk_handles.size()), bulk_handles.push_back(int(it.col()));
-          bulk_entries.emplace_back(h, scale * it.value() * grads_[t].row(k).transpose());
-        }
-      }
-      bulk_first.push_back(int(bulk_entries.size()));
-    }
     for (int k = 0; k < 4; ++k) {
       const Vec3 gk = grads_[t].row(k).transpose();
       if (slot[k] >= 0) {
@@ -271,19 +250,11 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
           out.Hqp.block<3, 3>(row, 3 * long(c.cross_slot[size_t(e)])) += it.value() * node_cross[size_t(e)];
       }
     }
-  if (bulk_hessian && !bulk_handles.empty()) {
-    MatX C = MatX::Zero(3 * long(bulk_handles.size()), long(bulk_first.size()) - 1);
-    for (size_t e = 0; e + 1 < bulk_first.size(); ++e)
-      for (int i = bulk_first[e]; i < bulk_first[e + 1]; ++i)
-        C.block<3, 1>(3 * bulk_entries[size_t(i)].first, long(e)) += bulk_entries[size_t(i)].second;
-    MatX G = MatX::Zero(C.rows(), C.rows());
-    G.selfadjointView<Eigen::Lower>().rankUpdate(C);
-    G.triangularView<Eigen::StrictlyUpper>() = G.transpose();
-    for (size_t ia = 0; ia < bulk_handles.size(); ++ia)
-      for (size_t ib = 0; ib < bulk_handles.size(); ++ib)
-        out.Hqq.block<3, 3>(z0 + 3 * bulk_handles[ia], z0 + 3 * bulk_handles[ib]) +=
-            G.block<3, 3>(3 * long(ia), 3 * long(ib));
-  }
+  if (q_hessian)  // the bulk share, constant over the step (prepare_bulk_hessian)
+    for (size_t ia = 0; ia < c.bulk_handles.size(); ++ia)
+      for (size_t ib = 0; ib < c.bulk_handles.size(); ++ib)
+        out.Hqq.block<3, 3>(z0 + 3 * c.bulk_handles[ia], z0 + 3 * c.bulk_handles[ib]) +=
+            c.bulk_hessian.block<3, 3>(3 * long(ia), 3 * long(ib));
   return E;
 }
 
@@ -331,6 +302,13 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
     const int fc = c.faces[fi];
     std::array<int, 3> vs;
     for (int i = 0; i < 3; ++i) vs[i] = c.vertex_slot.at(a.surface_faces(fc, i));
+    // A face whose samples all lie outside: φ at its centre above twice its
+    // radius (a distance field changes by at most the distance moved; twice,
+    // and 1 mm, for interpolated grids) holds no touching sample.
+    const Vec3 centre = (xv[vs[0]] + xv[vs[1]] + xv[vs[2]]) / 3.0;
+    const double radius = std::sqrt(std::max({(xv[vs[0]] - centre).squaredNorm(), (xv[vs[1]] - centre).squaredNorm(),
+                                              (xv[vs[2]] - centre).squaredNorm()}));
+    if (field_->distance(T_inv * centre) > 2.0 * radius + 1e-3) continue;
     std::array<Vec3, 3> g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
     std::array<std::array<Mat3, 3>, 3> M;
     for (auto& row : M) row.fill(Mat3::Zero());

@@ -28,9 +28,11 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // report): the minimizer is kept.
   const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
   if (c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix()) return c.du;
-  VecX du = c.du;
-  // Warm start from the last linearization: the back-substitution of the
-  // bordered Newton system for the change of z (the bones' change is left out).
+  // The step's first start: δu extrapolated from its last two steps (a dent
+  // that deepens keeps deepening); then the last linearization's
+  // back-substitution of the bordered Newton system for the change of z (the
+  // bones' change is left out).
+  VecX du = !c.solved && c.du_predicted.size() == c.du.size() ? c.du_predicted : c.du;
   if (c.linearized && c.z_lin.size() == q.z.size()) du = c.du_lin - c.Hpp_llt.solve(c.Hpz * (q.z - c.z_lin));
   Evaluation ev, trial;
   ++c.minimizations;
@@ -46,8 +48,14 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // A start that inverts a tet (the warm start, or the subspace itself at
   // this q): the last minimizer, then no patch displacement; if every start
   // is inadmissible the term's energy is +inf there and the step backtracks.
+  // A full step's trial is evaluated with its derivatives: accepted, it
+  // starts the next iteration (Armijo's check and the next Newton step share
+  // one evaluation).
+  bool evaluated = false;  // `ev` holds the evaluation at du
+  double E0 = 0;
   for (int it = 0; it < options_.max_inner_iterations; ++it) {
-    double E0 = evaluate_patch(ctx, q, du, exact, ev);
+    if (!evaluated) E0 = evaluate_patch(ctx, q, du, exact, ev);
+    evaluated = false;
     if (it == 0 && !std::isfinite(E0)) {
       du = c.du;
       E0 = evaluate_patch(ctx, q, du, exact, ev);
@@ -72,12 +80,12 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
       }
     }
     const VecX step = llt.solve(-ev.gp);
-    const double slope = ev.gp.dot(step);
-    if (-slope <= options_.inner_tolerance * std::max(std::abs(E0), 1e-12)) break;
-    double alpha = 1;
+    const double slope = ev.gp.dot(step), scale = std::max(std::abs(E0), 1e-12);
+    if (-slope <= options_.inner_tolerance * scale) break;
+    double alpha = 1, E1 = E0;
     bool ok = false;
     for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
-      const double E1 = evaluate_patch(ctx, q, du + alpha * step, energy_only, trial);
+      E1 = evaluate_patch(ctx, q, du + alpha * step, halving == 0 ? exact : energy_only, trial);
       if (std::isfinite(E1) && E1 <= E0 + 1e-4 * alpha * slope + 1e-15 * std::abs(E0)) {
         ok = true;
         break;
@@ -87,6 +95,11 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     du += alpha * step;
     ++c.inner_iterations;
     if (alpha * step.cwiseAbs().maxCoeff() < 1e-13) break;
+    if (alpha == 1.0) {
+      std::swap(ev, trial);
+      E0 = E1;
+      evaluated = true;
+    }
   }
   c.du = du;
   c.solved = true;

@@ -41,6 +41,7 @@ class CapsuleContactTerm : public EnergyTerm {
   CapsuleContactTerm(const Avatar& a, const Avatar* b, const CapsuleContactOptions& options = {});
   std::string name() const override { return self_ ? "self_contact" : "body_contact"; }
   BodyBlocks blocks() const override { return BodyBlocks::Bones; }
+  bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;

@@ -123,6 +123,7 @@ class ContactPatchTerm : public EnergyTerm {
   std::vector<std::string> input_frames() const override {
     return dynamic_ ? std::vector<std::string>{} : std::vector<std::string>{object_};
   }
+  bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;
@@ -169,6 +170,8 @@ class ContactPatchTerm : public EnergyTerm {
   // begin_step's parts (contact_patch.cpp), each filling the term's cache:
   void collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const;
   void prepare_patch_tets(TermCache& cache) const;
+  /// The bulk share of Φ_zz the patch tets add (cache's bulk_hessian), kept while they stay the same.
+  void prepare_bulk_hessian(TermCache& cache) const;
   /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
   void select_patch_nodes(TermCache& cache, const std::vector<int>& seeds, const std::vector<double>& seed_phi) const;
   /// The dynamic object's 6 DoFs in the term's local system, or −1.

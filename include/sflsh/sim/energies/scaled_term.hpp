@@ -27,6 +27,7 @@ class ScaledTerm final : public EnergyTerm {
   std::unique_ptr<TermCache> make_cache() const override { return inner_->make_cache(); }
   void begin_step(const StepContext& ctx) const override { inner_->begin_step(ctx); }
   bool active(const StepContext& ctx) const override { return inner_->active(ctx); }
+  bool in_nonlinearity_check() const override { return inner_->in_nonlinearity_check(); }
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override {
     return inner_->report(ctx, q);
   }

@@ -83,6 +83,7 @@ class SdfContactTerm : public EnergyTerm {
   std::string name() const override { return "contact:" + object_; }
   /// Static or kinematic: `object`; dynamic: its moving shape's frame (optional).
   std::vector<std::string> input_frames() const override;
+  bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;

@@ -67,6 +67,7 @@ class SkinContactTerm : public EnergyTerm {
   /// Throws one line on bad options.
   SkinContactTerm(const Avatar& a, const Avatar& b, const SkinContactOptions& options = {});
   std::string name() const override { return "skin_contact"; }
+  bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;
