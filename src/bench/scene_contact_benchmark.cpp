@@ -213,6 +213,7 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
   {
     SceneSessionOptions so;
     so.progress = set.progress;
+    so.inject_nan_at_step = set.inject_nan_at_step;
     SceneSession session(sc, so);
     const SimulationResult header = session.result_header();
     std::vector<int> object_index(np, -1);
@@ -254,7 +255,11 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
     };
     log_info("bench-contact: " + where + ": reduced solver");
     clock.start();
-    run_scene(session, ro);
+    try {
+      run_scene(session, ro);
+    } catch (const SimulationStopped& e) {
+      fail("reduced solver: ", e.what());
+    }
   }
 
   // The same scene without the compared objects and tools: its step times.

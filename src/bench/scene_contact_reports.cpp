@@ -64,8 +64,9 @@ void write_scene_contact_plot_svg(const SceneContactBenchResult& r, const std::s
     const std::string color = io::plot_color(c++);
     const std::string name = r.pairs.size() > 1 ? p.object + ": " : "";
     series.push_back({name + "full FEM", x, full, color, true});
-    series.push_back({name + "reduced (peak " + percent(p.peak_reduced_n / p.peak_full_n - 1.0) + ")", x, reduced,
-                      color, false});
+    char label[64];
+    std::snprintf(label, sizeof label, "reduced (peak %+.0f %%)", 100.0 * (p.peak_reduced_n / p.peak_full_n - 1.0));
+    series.push_back({name + label, x, reduced, color, false});
   }
   io::write_line_plot_svg(path, r.scene + ": contact force, reduced vs. full FEM",
                           by_depth ? "depth: the object's travel since first contact (mm)" : "time (s)",

@@ -141,7 +141,7 @@ TEST_F(SceneContactBench, FiguresAreThoseOfBothSolversRunsAndTheDepthIsTheBallsT
   EXPECT_NE(md.str().find("above 5 % of its peak"), std::string::npos) << md.str();
 }
 
-TEST_F(SceneContactBench, AStaticObjectHasNoDepthAndRefusedScenesAreRefusedNamingTheScene) {
+TEST_F(SceneContactBench, AStaticObjectHasNoDepthAndRefusedOrNonFiniteScenesFailNamingTheScene) {
   const SceneDescription pressed =
       read_scene_description(write_scene(ball_scene("static", "    position: [0.0, 0.037, 0.0]\n")));
   Progress::set_quiet(true);
@@ -172,5 +172,9 @@ TEST_F(SceneContactBench, AStaticObjectHasNoDepthAndRefusedScenesAreRefusedNamin
   brief.solver.seconds = 0.02;
   Progress::set_quiet(true);
   test::expect_error([&] { run_scene_contact_bench(brief, quiet()); }, {"scene.yaml", "no contact", "ball"});
+  // A non-finite value in the reduced run: stopped, naming the solver, the scene and the step.
+  SceneContactBenchSettings nan = quiet();
+  nan.inject_nan_at_step = 3;
+  test::expect_error([&] { run_scene_contact_bench(shorter, nan); }, {"reduced solver", "scene.yaml", "step 3"});
   Progress::set_quiet(false);
 }

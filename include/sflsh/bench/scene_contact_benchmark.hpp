@@ -43,6 +43,8 @@ struct SceneContactBenchSettings {
   double force_threshold = 0.05;  ///< share of the full FEM's peak force above which rms_err counts a step
   double dent_reach = 0.01;       ///< m: skin this close to the object's surface counts for the dent
   bool progress = true;
+  /// TEST ONLY: SceneSessionOptions::inject_nan_at_step of the reduced run (0: off).
+  long inject_nan_at_step = 0;
 };
 
 /// One contact pair (the body and one object or tool) of a scene.
