@@ -18,6 +18,7 @@
 #include "sflsh/reference/full_fem.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
+#include "bench/step_median.hpp"
 
 namespace sflsh {
 namespace {
@@ -255,14 +256,6 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
   return tr;
 }
 
-/// Median of `ms` over the steps flagged in `when` (all steps if none is).
-double median_when(const std::vector<double>& ms, const std::vector<bool>& when) {
-  std::vector<double> picked;
-  for (size_t i = 0; i < ms.size(); ++i)
-    if (when[i]) picked.push_back(ms[i]);
-  return percentile(picked.empty() ? ms : picked, 0.5);
-}
-
 /// Peak inward displacement (m) over the steps of the vertices within `reach` of the site.
 double peak_dent(const Trace& tr, const Avatar& a, const Site& site, double reach) {
   double dent = 0;
@@ -438,36 +431,39 @@ void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::str
 
 void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
                                   const std::string& heading) {
-  io::write_text_file(path, [&](std::ostream& f) {
-    f << heading << "\n\n| scene | K | dt (s) | rel_err | dent full (mm) | dent reduced (mm) | dent ratio | peak force "
-                    "full / reduced (N) | active samples full / reduced | µs / sample / iter | ms/step contact | ms/step no contact "
-                    "| ratio | full FEM ms/step |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    char buf[512];
-    for (const auto& r : rows) {
-      std::snprintf(buf, sizeof buf,
-                    "| %s | %d | 1/%.0f | %.3f | %.2f | %.2f | %.3f | %.1f / %.1f | %d / %d | %.3f | %.3g | %.3g | %.2f | "
-                    "%.3g |\n",
-                    r.scene.c_str(), r.handles, 1.0 / r.dt, r.rel_err, r.dent_full_mm, r.dent_reduced_mm, r.dent_ratio,
-                    r.force_full_n, r.force_reduced_n, r.active_samples_full, r.active_samples, r.us_per_sample_iter,
-                    r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
-      f << buf;
-    }
-    bool header = false;
-    for (const auto& r : rows) {
-      if (r.scene.rfind("probe", 0) != 0) continue;
-      if (!header)
-        f << "\nProbes: force at 10 mm depth (first crossing on the loading ramp), the RMS of the relative force "
-             "error over the loading curve at 2–10 mm, the dent, and the largest patch:\n\n| scene | K | full FEM (N) | "
-             "reduced (N) | error at 10 mm | RMS error 2–10 mm | dent full / reduced (mm) | patch nodes |\n"
-             "|---|---|---|---|---|---|---|---|\n";
-      header = true;
-      std::snprintf(buf, sizeof buf, "| %s | %d | %.2f | %.2f | %.0f %% | %.0f %% | %.2f / %.2f | %d |\n",
-                    r.scene.c_str(), r.handles, r.force_at_depth_full_n, r.force_at_depth_reduced_n,
-                    100.0 * r.force_err, 100.0 * r.force_rms_err, r.dent_full_mm, r.dent_reduced_mm,
-                    r.max_patch_nodes);
-      f << buf;
-    }
-  });
+  io::write_text_file(path, [&](std::ostream& f) { write_contact_bench_markdown(rows, heading, f); });
+}
+
+void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& heading,
+                                  std::ostream& f) {
+  f << heading << "\n\n| scene | K | dt (s) | rel_err | dent full (mm) | dent reduced (mm) | dent ratio | peak force "
+                  "full / reduced (N) | active samples full / reduced | µs / sample / iter | ms/step contact | ms/step no contact "
+                  "| ratio | full FEM ms/step |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char buf[512];
+  for (const auto& r : rows) {
+    std::snprintf(buf, sizeof buf,
+                  "| %s | %d | 1/%.0f | %.3f | %.2f | %.2f | %.3f | %.1f / %.1f | %d / %d | %.3f | %.3g | %.3g | %.2f | "
+                  "%.3g |\n",
+                  r.scene.c_str(), r.handles, 1.0 / r.dt, r.rel_err, r.dent_full_mm, r.dent_reduced_mm, r.dent_ratio,
+                  r.force_full_n, r.force_reduced_n, r.active_samples_full, r.active_samples, r.us_per_sample_iter,
+                  r.ms_contact, r.ms_no_contact, r.step_ratio, r.ms_full);
+    f << buf;
+  }
+  bool header = false;
+  for (const auto& r : rows) {
+    if (r.scene.rfind("probe", 0) != 0) continue;
+    if (!header)
+      f << "\nProbes: force at 10 mm depth (first crossing on the loading ramp), the RMS of the relative force "
+           "error over the loading curve at 2–10 mm, the dent, and the largest patch:\n\n| scene | K | full FEM (N) | "
+           "reduced (N) | error at 10 mm | RMS error 2–10 mm | dent full / reduced (mm) | patch nodes |\n"
+           "|---|---|---|---|---|---|---|---|\n";
+    header = true;
+    std::snprintf(buf, sizeof buf, "| %s | %d | %.2f | %.2f | %.0f %% | %.0f %% | %.2f / %.2f | %d |\n",
+                  r.scene.c_str(), r.handles, r.force_at_depth_full_n, r.force_at_depth_reduced_n,
+                  100.0 * r.force_err, 100.0 * r.force_rms_err, r.dent_full_mm, r.dent_reduced_mm,
+                  r.max_patch_nodes);
+    f << buf;
+  }
 }
 
 }  // namespace sflsh

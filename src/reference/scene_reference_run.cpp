@@ -5,6 +5,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/progress.hpp"
+#include "sflsh/core/timer.hpp"
 #include "sflsh/scene/rigid_object.hpp"
 #include "sflsh/scene/scene_session.hpp"
 #include "sflsh/reference/full_fem.hpp"
@@ -25,9 +26,9 @@ bool collides(const ContactDescription& c, const std::string& body, const std::s
   return false;
 }
 
-/// The scene as the reference runs it: refusals thrown, dynamic bones made
-/// kinematic and friction dropped (each with a warning).
-SceneDescription reference_scene(const SceneDescription& sc) {
+}  // namespace
+
+void check_scene_reference(const SceneDescription& sc) {
   const std::string& where = scene_name(sc);
   require(sc.bodies.size() == 1, where, ": --solver full runs one body; the scene has ", sc.bodies.size(),
           " (body-body contact has no full-FEM reference yet)");
@@ -40,6 +41,15 @@ SceneDescription reference_scene(const SceneDescription& sc) {
     require(t.jaws.empty() && t.sensors.empty(), where, ": tools '", t.name,
             "' has jaws or a grasp; --solver full has no anchors");
   }
+}
+
+namespace {
+
+/// The scene as the reference runs it: refusals thrown, dynamic bones made
+/// kinematic and friction dropped (each with a warning).
+SceneDescription reference_scene(const SceneDescription& sc) {
+  check_scene_reference(sc);
+  const std::string& where = scene_name(sc);
   SceneDescription out = sc;
   if (out.bodies[0].bones_dynamic) {
     std::cerr << "warning: " << where << ": bodies '" << out.bodies[0].name
@@ -112,7 +122,9 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     const std::vector<Isometry> all = session.object_poses();
     std::vector<Isometry> poses;
     for (int i : obstacle_object) poses.push_back(all.at(size_t(i)));
+    const double cpu0 = thread_cpu_ms();
     const FullFemReport rep = fem.step(sim.state(body).bones, poses);
+    const double cpu_ms = thread_cpu_ms() - cpu0;
     const double t = (k + 1) * session.dt();
     if (!rep.converged) ++not_converged;
     for (size_t i = 0; i < rep.contacts.size(); ++i) {
@@ -140,6 +152,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
       ms_since_frame = 0;
       steps_since_frame = 0;
     }
+    if (opt.on_step) opt.on_step({k + 1, t, &fem, &rep, &poses, cpu_ms});
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();

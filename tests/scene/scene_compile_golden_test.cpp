@@ -258,6 +258,13 @@ TEST_F(SceneCompileGolden, SlabOnBelly) {
           "9795bcc04e365eb1", "4186a2a4550db76a", "7dca32eb0aabe095", 0}});
 }
 
+// The probe touches the box's front face at 0.1 s (step 6) and is 2 mm in at step 12.
+TEST_F(SceneCompileGolden, ProbeBelly) {
+  check({"figures/probe_belly.yaml", at_belly, 12,
+         {"inertia@0; elastic@0; contact:probe@0", "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
+          "d48f112e19027b1d", "d407702e52393dc4", "f5dc3864a7d12373", 0}});
+}
+
 TEST_F(SceneCompileGolden, SphereOnBelly) {
   check({"figures/sphere_on_belly.yaml", at_belly, 10,
          {"inertia@0; elastic@0; gravity@0; bone_inertia@1; bone_gravity@1; contact:ball@0,1",
@@ -357,5 +364,5 @@ TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
   for (const char* dir : {"apps/scenes", "apps/scenes/figures"})
     for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(test::source_dir()) / dir))
       scenes += e.path().extension() == ".yaml";
-  EXPECT_EQ(scenes, 14) << "a new example scene: add it to SceneCompileGolden";
+  EXPECT_EQ(scenes, 15) << "a new example scene: add it to SceneCompileGolden";
 }

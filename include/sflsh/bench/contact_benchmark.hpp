@@ -39,6 +39,7 @@
 //                 samples × Newton iterations), over the steps with contact;
 //   step_ratio  = median reduced step time over the steps with contact /
 //                 median step time of the same steps of the scene without the object.
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -136,5 +137,8 @@ void write_probe_curves(const std::vector<ContactBenchRow>& rows, const std::str
 /// The rows as a Markdown table, `heading` (Markdown) above it.
 void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& path,
                                   const std::string& heading);
+/// The same Markdown to a stream.
+void write_contact_bench_markdown(const std::vector<ContactBenchRow>& rows, const std::string& heading,
+                                  std::ostream& out);
 
 }  // namespace sflsh

@@ -15,14 +15,36 @@
 // run kinematic and friction is dropped, each with a warning line on stderr.
 // Cost: seconds per step on the default body (a sparse Cholesky of ~30k DoFs
 // per Newton iteration); progress is shown.
+#include <functional>
+#include <vector>
+
 #include "sflsh/scene/scene_run.hpp"
 
 namespace sflsh {
 
+class FullFem;
+struct FullFemReport;
+
+/// What SceneReferenceOptions::on_step sees after a step.
+struct SceneReferenceStep {
+  long step = 0;                                    ///< 1-based
+  double time = 0;                                  ///< s, at the end of the step
+  const FullFem* fem = nullptr;                     ///< the reference (posed_surface(), soft_displacement())
+  const FullFemReport* report = nullptr;            ///< contacts: one per obstacle, in the stats' pair order
+  const std::vector<Isometry>* obstacle_poses = nullptr;  ///< world, one per obstacle
+  double cpu_ms = 0;                                ///< thread CPU time of the reference's step
+};
+
 struct SceneReferenceOptions {
   bool progress = true;
   int max_iterations = 50;     ///< Newton iterations per step at most (FullFemOptions)
+  /// Called after every step (e.g. the contact benchmark's per-step figures); may be empty.
+  std::function<void(const SceneReferenceStep&)> on_step;
 };
+
+/// Throws the one-line refusal (header comment) when the reference cannot run
+/// `scene`; nothing otherwise (the warnings come with the run).
+void check_scene_reference(const SceneDescription& scene);
 
 /// Runs `scene` with the full-FEM reference; the result has the reduced run's
 /// layout (frames of the body's skin, objects' and tools' poses; no reduced
