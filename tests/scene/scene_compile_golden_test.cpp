@@ -262,7 +262,7 @@ TEST_F(SceneCompileGolden, SlabOnBelly) {
 TEST_F(SceneCompileGolden, ProbeBelly) {
   check({"figures/probe_belly.yaml", at_belly, 12,
          {"inertia@0; elastic@0; contact:probe@0", "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
-          "d48f112e19027b1d", "d407702e52393dc4", "f5dc3864a7d12373", 0}});
+          "d48f112e19027b1d", "5734bb020626946e", "f5dc3864a7d12373", 0}});
 }
 
 TEST_F(SceneCompileGolden, SphereOnBelly) {

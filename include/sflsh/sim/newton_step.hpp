@@ -67,7 +67,10 @@ struct NewtonOptions {
   /// nothing, the trial energy is evaluated anyway. With bones prescribed,
   /// |ρ − 1| stays ≤ 0.046 on `jump` (where a second iteration changes
   /// nothing) and exceeds 0.05 on about a quarter of the steps of `shake` and
-  /// a CMU run. 0 = off.
+  /// a CMU run. Contact terms are left out (EnergyTerm::in_nonlinearity_check):
+  /// then the other terms' change is compared with their own quadratic model,
+  /// and the departure counted as a share of the whole step's predicted decrease.
+  /// 0 = off.
   /// Unset (the default): kAutoNonlinearityTolerance when every DoF of the
   /// step is soft tissue (bones prescribed, no dynamic rigid object or tool), off
   /// otherwise: dynamic bones' rotations make ρ depart from 1 on most steps of
