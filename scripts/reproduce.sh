@@ -184,7 +184,7 @@ for step in $STEPS; do
     if [ "$QUICK" = 1 ]; then
       run "$SFLSH" bench-contact --quick --handles 16 --scenes probe --out "$d"
     else
-      run "$SFLSH" bench-contact --handles 96 --scenes probe,probe-belly,probe-calf-1cm --out "$d"
+      run "$SFLSH" bench-contact --handles 96 --scenes probe,probe-belly,probe-calf-1cm --cpu-time --out "$d"
     fi
     stamp "$d/contact_bench.md" "$OUT/contact_patch.md"
     stamp "$d/contact_probe.svg" "$OUT/contact_patch_probe.svg" ;;

@@ -420,6 +420,39 @@ TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFinit
   }
 }
 
+/// The skin displacement the patches add: each skin vertex takes its tet's
+/// nodes' δu barycentrically, summed over the terms of its body; other
+/// bodies' reports and other quantities are ignored; a malformed report throws.
+TEST(ContactPatch, TheSkinTakesItsTetsNodesPatchDisplacementBarycentrically) {
+  const Avatar a = slab(4);
+  const int v = 5, t = a.surface_tet[v];
+  const int n0 = a.tet.elements(t, 0), n2 = a.tet.elements(t, 2);
+  StepReport rep;
+  // Two terms displace node n0, one node n2; a third term is on body 1.
+  rep.quantities.push_back({"contact:a", 0, "patch_displacement", "m", {double(n0), 1e-3, -2e-3, 0.5e-3}});
+  rep.quantities.push_back({"contact:b", 0, "patch_displacement", "m", {double(n0), 2e-3, 0.0, 0.0, double(n2), 0.0, 0.0, 4e-3}});
+  rep.quantities.push_back({"contact:c", 1, "patch_displacement", "m", {double(n2), 9.0, 9.0, 9.0}});
+  rep.quantities.push_back({"contact:a", 0, "force", "N", {1.0, 2.0, 3.0, 4.0}});
+  const Points u = patch_surface_displacement(a, rep, 0);
+  ASSERT_EQ(u.rows(), a.surface_rest.rows());
+  const double b0 = a.surface_bary(v, 0), b2 = a.surface_bary(v, 2);
+  const Vec3 expected = b0 * Vec3(3e-3, -2e-3, 0.5e-3) + b2 * Vec3(0, 0, 4e-3);
+  EXPECT_LT((u.row(v).transpose() - expected).norm(), 1e-15) << u.row(v);
+  EXPECT_GT(expected.norm(), 1e-4);  // the vertex is displaced at all (barycentric weights not 0)
+  // A vertex whose tet has neither node stays.
+  for (int w = 0; w < u.rows(); ++w) {
+    bool touched = false;
+    for (int c = 0; c < 4; ++c) touched |= a.tet.elements(a.surface_tet[w], c) == n0 || a.tet.elements(a.surface_tet[w], c) == n2;
+    if (!touched) EXPECT_TRUE(u.row(w).isZero()) << "vertex " << w;
+  }
+  EXPECT_TRUE(patch_surface_displacement(a, StepReport(), 0).isZero());
+  StepReport bad;
+  bad.quantities.push_back({"contact:a", 0, "patch_displacement", "m", {double(n0), 1e-3, 0.0}});
+  EXPECT_THROW(patch_surface_displacement(a, bad, 0), Error);
+  bad.quantities[0].value = {double(a.tet.num_nodes()), 0.0, 0.0, 0.0};
+  EXPECT_THROW(patch_surface_displacement(a, bad, 0), Error);
+}
+
 TEST(ContactPatch, BadOptionsAreRefusedNamingTheContact) {
   const Avatar a = slab(4);
   auto sphere = std::make_shared<geometry::SphereSdf>(0.01);

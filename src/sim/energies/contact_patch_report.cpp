@@ -41,25 +41,24 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
 }
 
 Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {
-  std::unordered_map<int, Vec3> du;
+  // δu per tet node (zero where no patch is; empty: no patch at all).
+  std::vector<Vec3> du;
   for (const TermQuantityReport& q : report.quantities) {
     if (q.body != body || q.name != "patch_displacement") continue;
     require(q.value.size() % 4 == 0, "patch_surface_displacement: '", q.term, "' reports ", q.value.size(),
             " values, expected 4 per patch node");
+    if (du.empty()) du.assign(size_t(a.tet.num_nodes()), Vec3::Zero());
     for (size_t i = 0; i < q.value.size(); i += 4) {
       const int n = int(q.value[i]);
       require(n >= 0 && n < a.tet.num_nodes(), "patch_surface_displacement: node ", n, " out of [0, ",
               a.tet.num_nodes(), ")");
-      du.try_emplace(n, Vec3::Zero()).first->second += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
+      du[size_t(n)] += Vec3(q.value[i + 1], q.value[i + 2], q.value[i + 3]);
     }
   }
   Points u = Points::Zero(a.surface_rest.rows(), 3);
   if (du.empty()) return u;
   for (int v = 0; v < u.rows(); ++v)
-    for (int c = 0; c < 4; ++c) {
-      const auto it = du.find(a.tet.elements(a.surface_tet[v], c));
-      if (it != du.end()) u.row(v) += a.surface_bary(v, c) * it->second.transpose();
-    }
+    for (int c = 0; c < 4; ++c) u.row(v) += a.surface_bary(v, c) * du[size_t(a.tet.elements(a.surface_tet[v], c))].transpose();
   return u;
 }
 
