@@ -76,8 +76,9 @@ struct ToolEvent {
   int points = 0;                ///< skin points anchored or let go
 };
 
-/// A contact term of a scene at one output frame (the step before it; zero
-/// while the term is inactive).
+/// A contact term of a scene at one output frame: its report at the end of
+/// the step before the frame (zero before the first step and while the term
+/// is inactive).
 struct ContactFrame {
   Vec3 force = Vec3::Zero();  ///< N, world: what the term exerts on its body
   /// m, world: where it acts, the force-weighted mean of the term's active
