@@ -4,12 +4,15 @@
 #include <iostream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "command.hpp"
 #include "sflsh/asset/avatar_file.hpp"
 #include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/io/input_file.hpp"
 #include "sflsh/precompute/avatar_summary.hpp"
+#include "sflsh/scene/result_contacts.hpp"
 #include "sflsh/scene/result_file.hpp"
 
 namespace sflsh::cli {
@@ -20,7 +23,8 @@ struct InspectArgs {
   bool json = false;
 };
 
-/// A result file (it has /frames): its summary; "incomplete" when the run stopped early.
+/// A result file (it has /frames): its summary ("incomplete" when the run
+/// stopped early) and its contact terms with their peak force.
 bool inspect_result(const InspectArgs& args) {
   bool is_result = false;
   auto sniff = [&] {
@@ -32,11 +36,16 @@ bool inspect_result(const InspectArgs& args) {
   if (!is_result) return false;
   const SimulationResult r = read_simulation_result(args.path);
   if (args.json) {
-    std::printf("{\"file\": \"result\", \"frames\": %d, \"steps\": %zu, \"incomplete\": %s}\n", int(r.frame_time.size()),
-                r.step_time.size(), r.incomplete ? "true" : "false");
+    nlohmann::json contacts = nlohmann::json::array();
+    for (const ContactTrack& c : r.contacts)
+      contacts.push_back({{"term", c.term}, {"body", c.body}, {"peak_force", peak_contact_force(c)}});
+    const nlohmann::json j = {{"file", "result"}, {"frames", r.frame_time.size()}, {"steps", r.step_time.size()},
+                              {"incomplete", r.incomplete}, {"contacts", contacts}};
+    std::printf("%s\n", j.dump().c_str());
   } else {
     std::printf("%s: simulation result, %d frames, %zu steps, %s\n", args.path.c_str(), int(r.frame_time.size()),
                 r.step_time.size(), r.incomplete ? ("INCOMPLETE (" + r.stop_reason + ")").c_str() : "complete");
+    std::fputs(describe_contacts(r).c_str(), stdout);
   }
   return true;
 }

@@ -104,8 +104,20 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   SceneContactStats st;
   for (int i = 0; i < fem.num_obstacles(); ++i)
     st.pairs.push_back({"contact:" + r.objects[size_t(obstacle_object[size_t(i)])].name, body_name});
+  // The result's contacts are the reference's obstacles (not the session's
+  // reduced-model terms), each drawn at its obstacle's position (FullFemContact has no point).
+  r.contacts.clear();
+  std::vector<ContactFrame> contacts(st.pairs.size());
+  for (size_t i = 0; i < st.pairs.size(); ++i) {
+    r.contacts.push_back({st.pairs[i].term, body_name, {}});
+    contacts[i].point = session.object_poses().at(size_t(obstacle_object[i])).translation();
+  }
   auto record = [&](double ms) {
-    session.record_frame(r, ms);
+    FrameData fr = session.frame(ms);
+    fr.contacts = contacts;
+    r.add_frame(std::move(fr));
+    r.tool_events = session.tool_events();
+    ++r.num_frames;
     r.frame_positions.back() = fem.posed_surface();
     r.frame_displacement.back() = fem.soft_displacement();
     r.frame_reduced.back().setZero();  // the reference has no reduced coordinates
@@ -134,6 +146,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
       p.max_force = std::max(p.max_force, c.force.norm());
       p.max_penetration = std::max(p.max_penetration, c.max_penetration);
       if (c.active_samples > 0) ++p.active_steps;
+      contacts[i] = {c.force, poses.at(i).translation(), c.max_penetration, c.active_samples};
     }
     StepReport sr;  // Newton to convergence: each step counts as accepted (non-converged ones are warned about)
     sr.accepted = 1;

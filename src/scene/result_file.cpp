@@ -6,6 +6,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/crash_isolation.hpp"
+#include "sflsh/scene/result_contacts.hpp"
 
 namespace sflsh {
 namespace {
@@ -94,9 +95,10 @@ std::vector<Points> unstack(const std::vector<double>& flat, const std::vector<s
 }  // namespace
 
 ResultScene result_scene(const SimulationResult& r) {
-  ResultScene s{r.body_names, r.body_vertex_offsets, r.objects, {}};
+  ResultScene s{r.body_names, r.body_vertex_offsets, r.objects, {}, r.contacts};
   for (ObjectTrack& t : s.objects) t.poses.clear();
   for (const ToolTrack& t : r.tools) s.tool_names.push_back(t.name);
+  for (ContactTrack& c : s.contacts) c.frames.clear();
   return s;
 }
 
@@ -153,6 +155,9 @@ ResultWriter::ResultWriter(const std::string& path, const Triangles& faces, cons
   }
   for (size_t t = 0; t < scene.tool_names.size(); ++t) f.write_string(tool_group(t) + "/name", scene.tool_names[t]);
   tool_names_ = scene.tool_names;
+  contacts_ = scene.contacts;
+  for (ContactTrack& c : contacts_) c.frames.clear();
+  create_contact_datasets(f, contacts_);
   f.create_appendable("/frames/time", {});
   f.create_appendable("/frames/step_ms", {});
   f.create_appendable("/frames/positions", {V, 3}, true);
@@ -190,6 +195,8 @@ void ResultWriter::add_frame(const FrameData& fr) {
     require(ok, at, ": ", name, " holds a non-finite value; not written");
   require(fr.tools.size() == tool_names_.size(), at, ": ", fr.tools.size(), " tool frames for ", tool_names_.size(),
           " tools");
+  require(fr.contacts.size() == contacts_.size(), at, ": ", fr.contacts.size(), " contact frames for ",
+          contacts_.size(), " contacts");
   std::vector<double> poses(7 * object_names_.size());
   for (size_t o = 0; o < object_names_.size(); ++o)
     pose_to_row(fr.object_poses[o], &poses[7 * o], at + ": the pose of object '" + object_names_[o] + "'");
@@ -202,6 +209,7 @@ void ResultWriter::add_frame(const FrameData& fr) {
   if (target_pelvis_) f.append("/frames/target_pelvis", fr.target_pelvis.data());
   if (!object_names_.empty()) f.append("/frames/object_poses", poses.data());
   if (!tool_names_.empty()) append_tool_frames(fr.tools, at);
+  append_contact_frames(f, contacts_, fr.contacts, at);
   ++frames_;
 }
 
@@ -278,6 +286,9 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
   for (const ToolTrack& t : r.tools)
     require(t.frames.size() == r.frame_time.size(), path, ": tool '", t.name, "' has ", t.frames.size(),
             " frames for ", r.frame_time.size(), " frames");
+  for (const ContactTrack& c : r.contacts)
+    require(c.frames.size() == r.frame_time.size(), path, ": contact '", c.term, "' on '", c.body, "' has ",
+            c.frames.size(), " frames for ", r.frame_time.size(), " frames");
   ResultWriter w(path, r.faces, r.surface_rest, nr, !r.frame_target_pelvis.empty(), result_scene(r));
   for (size_t i = 0; i < r.frame_time.size(); ++i) {
     FrameData fr;
@@ -290,6 +301,7 @@ void write_simulation_result(const SimulationResult& r, const std::string& path)
     if (!r.frame_target_pelvis.empty()) fr.target_pelvis = r.frame_target_pelvis[i];
     for (const ObjectTrack& t : r.objects) fr.object_poses.push_back(t.poses[i]);
     for (const ToolTrack& t : r.tools) fr.tools.push_back(t.frames[i]);
+    for (const ContactTrack& c : r.contacts) fr.contacts.push_back(c.frames[i]);
     w.add_frame(fr);
   }
   w.finish(r);
@@ -408,6 +420,7 @@ static SimulationResult read_simulation_result_in_this_process(const std::string
                                                  ", object " + std::to_string(o)));
   }
   read_tools(f, path, F, r);
+  r.contacts = read_contacts(f, F);  // absent in files written before contacts were stored
   MatXr red = f.read_matrix("/frames/reduced", F, -1);
   for (std::int64_t i = 0; i < F; ++i) r.frame_reduced.push_back(red.row(i).transpose());
   MatXr ms = f.read_matrix("/frames/step_ms", F, 1);

@@ -149,9 +149,10 @@ int add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::string
   return mb.add_term(term, {b.model_index});
 }
 
-/// Adds one contact term per colliding body–object pair.
+/// Adds one contact term per colliding body–object pair; appends their model indices to `terms`.
 void add_object_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodies,
-                         const std::vector<CompiledObject>& objects, const SceneDescription& sc, SkinSamples& samples) {
+                         const std::vector<CompiledObject>& objects, const SceneDescription& sc, SkinSamples& samples,
+                         std::vector<int>& terms) {
   const ContactDescription& c = sc.contact;
   for (const CompiledBody& b : bodies)
     for (const CompiledObject& o : objects) {
@@ -160,8 +161,9 @@ void add_object_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodi
       require(!(c.patch && dynamic), sc.path, ": contact.patch: object '", o.desc->name,
               "' is dynamic; the contact patch takes static and kinematic objects (a dynamic one: "
               "remove contact.patch or make it kinematic)");
-      add_shape_contact(mb, b, o.desc->name, o.model.field, dynamic ? o.model.shape_in_body : Isometry::Identity(),
-                        dynamic, o.model_index, c.patch, c, samples);
+      terms.push_back(add_shape_contact(mb, b, o.desc->name, o.model.field,
+                                        dynamic ? o.model.shape_in_body : Isometry::Identity(), dynamic, o.model_index,
+                                        c.patch, c, samples));
     }
 }
 
@@ -229,8 +231,10 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
 }
 
 /// Adds one capsule contact term per colliding pair of bodies (skipped when
-/// both are kinematic) and one per body with self contact.
-void add_body_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodies, const SceneDescription& sc) {
+/// both are kinematic) and one per body with self contact; appends their
+/// model indices to `terms`.
+void add_body_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodies, const SceneDescription& sc,
+                       std::vector<int>& terms) {
   const ContactDescription& c = sc.contact;
   for (size_t i = 0; i < bodies.size(); ++i) {
     const CompiledBody& a = bodies[i];
@@ -245,16 +249,17 @@ void add_body_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodies
         SkinContactOptions so;
         so.pressure_stiffness = c.body_pressure_stiffness;
         so.spacing = c.body_spacing;
-        mb.add_term(std::make_shared<const SkinContactTerm>(*a.avatar, *b.avatar, so), {a.model_index, b.model_index});
+        terms.push_back(mb.add_term(std::make_shared<const SkinContactTerm>(*a.avatar, *b.avatar, so),
+                                    {a.model_index, b.model_index}));
       }
-      mb.add_term(std::make_shared<const CapsuleContactTerm>(
+      terms.push_back(mb.add_term(std::make_shared<const CapsuleContactTerm>(
                       *a.avatar, b.avatar.get(), CapsuleContactOptions{c.body_body_stiffness, 2, skin ? c.core_radius : 1.0}),
-                  {a.model_index, b.model_index});
+                  {a.model_index, b.model_index}));
     }
     if (c.self_contact && a.desc->bones_dynamic && !a.avatar->capsules.empty())
-      mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, nullptr,
-                                                             CapsuleContactOptions{c.self_stiffness, 2}),
-                  {a.model_index});
+      terms.push_back(mb.add_term(std::make_shared<const CapsuleContactTerm>(*a.avatar, nullptr,
+                                                                             CapsuleContactOptions{c.self_stiffness, 2}),
+                                  {a.model_index}));
   }
 }
 
@@ -342,9 +347,13 @@ CompiledScene compile_scene(const SceneDescription& sc, const SceneCompileOption
   add_bodies(mb, cs.bodies, sc, opt);
   cs.objects = add_objects(mb, sc, opt);
   SkinSamples samples;
-  add_object_contacts(mb, cs.bodies, cs.objects, sc, samples);
-  for (const ToolDescription& d : sc.tools) cs.tools.push_back(add_tool(mb, d, cs.bodies, sc.contact, samples));
-  add_body_contacts(mb, cs.bodies, sc);
+  add_object_contacts(mb, cs.bodies, cs.objects, sc, samples, cs.contact_terms);
+  for (const ToolDescription& d : sc.tools) {
+    cs.tools.push_back(add_tool(mb, d, cs.bodies, sc.contact, samples));
+    cs.contact_terms.insert(cs.contact_terms.end(), cs.tools.back().contact_terms.begin(),
+                            cs.tools.back().contact_terms.end());
+  }
+  add_body_contacts(mb, cs.bodies, sc, cs.contact_terms);
   cs.model = mb.build();
   mark_stiffness_terms(*cs.model, cs.bodies);
   cs.initial = initial_state(*cs.model, cs);

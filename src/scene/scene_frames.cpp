@@ -1,8 +1,9 @@
 // What a scene shows of itself (SceneSession): the result's constant header
 // (every body's skin, the objects' and tools' surfaces, the tools' names), its
 // output frames (skins, joints, object poses, every tool's pose, closure,
-// force and torque, and the grasp and release events so far) and the bodies'
-// current surfaces and joints.
+// force and torque, every contact term's force, point, depth and samples, and
+// the grasp and release events so far) and the bodies' current surfaces and
+// joints.
 #include "sflsh/scene/scene_session.hpp"
 
 #include "sflsh/sim/avatar_model.hpp"
@@ -77,7 +78,60 @@ SimulationResult SceneSession::result_header() const {
                            t.coupled() ? "dynamic" : "kinematic", t.jaws[j].model.surface.vertices,
                            t.jaws[j].model.surface.faces, {}});
   for (const CompiledTool& t : cs.tools) r.tools.push_back({t.desc->name, {}});
+  const Model& model = m.sim->model();
+  for (int i : cs.contact_terms) {
+    const Model::BoundTerm& t = model.terms()[size_t(i)];
+    r.contacts.push_back({t.term->name(), model.bodies()[size_t(t.bodies[0])].name, {}});
+  }
   return r;
+}
+
+std::vector<ContactFrame> SceneSession::Impl::contact_frames(const std::vector<Isometry>& poses) const {
+  const Model& model = sim->model();
+  std::vector<ContactFrame> out;
+  for (int i : compiled.contact_terms) {
+    const Model::BoundTerm& t = model.terms()[size_t(i)];
+    ContactFrame c;
+    bool has_point = false;
+    for (const TermQuantityReport& q : report.quantities) {
+      if (q.term_index != i) continue;
+      if (q.name == "force" && q.value.size() == 3) c.force = Vec3(q.value[0], q.value[1], q.value[2]);
+      if (q.name == "contact_point" && q.value.size() == 3) {
+        c.point = Vec3(q.value[0], q.value[1], q.value[2]);
+        has_point = true;
+      }
+      if ((q.name == "max_penetration" || q.name == "max_overlap") && q.value.size() == 1) c.max_penetration = q.value[0];
+      if ((q.name == "active_samples" || q.name == "overlapping_pairs") && q.value.size() == 1) c.active = int(q.value[0]);
+    }
+    if (!has_point) c.point = fallback_contact_point(t, poses);
+    out.push_back(c);
+  }
+  return out;
+}
+
+Vec3 SceneSession::Impl::fallback_contact_point(const Model::BoundTerm& t, const std::vector<Isometry>& poses) const {
+  // "contact:<object>": the object's (a tool's shape's, a jaw's) position, in
+  // object_poses' order; any other term: its body's pelvis.
+  const std::string name = t.term->name(), prefix = "contact:";
+  if (name.compare(0, prefix.size(), prefix) == 0) {
+    const std::string object = name.substr(prefix.size());
+    size_t k = 0;
+    for (const CompiledObject& o : compiled.objects) {
+      if (o.desc->name == object && k < poses.size()) return poses[k].translation();
+      ++k;
+    }
+    for (const CompiledTool& tool : compiled.tools)
+      if (tool.desc->has_shape) {
+        if (tool.desc->name == object && k < poses.size()) return poses[k].translation();
+        ++k;
+      }
+    for (const CompiledTool& tool : compiled.tools)
+      for (const CompiledJaw& j : tool.jaws) {
+        if (j.name == object && k < poses.size()) return poses[k].translation();
+        ++k;
+      }
+  }
+  return sim->joints(t.bodies[0]).row(0).transpose();
 }
 
 std::vector<Isometry> SceneSession::object_poses() const { return impl_->object_poses(impl_->sim->time()); }
@@ -122,11 +176,23 @@ FrameData SceneSession::frame(double ms) const {
   const CompiledBody& b0 = cs.bodies[0];
   fr.target_pelvis = target_bones(*b0.avatar, b0.target_pose(fr.time))[0] * Vec3(b0.avatar->joints_rest.row(0).transpose());
   fr.object_poses = m.object_poses(fr.time);
-  for (const ToolDriver& tool : m.tools) {
-    const SceneToolState& ts = tool.state();
-    fr.tools.push_back({tool.drawn_pose(fr.time), ts.device.closure, ts.force, ts.torque});
-  }
+  fr.tools = m.tool_frames(fr.time);
+  fr.contacts = m.contact_frames(fr.object_poses);
   return fr;
+}
+
+std::vector<ToolFrame> SceneSession::Impl::tool_frames(double t) const {
+  std::vector<ToolFrame> out;
+  for (const ToolDriver& tool : tools) {
+    const SceneToolState& ts = tool.state();
+    out.push_back({tool.drawn_pose(t), ts.device.closure, ts.force, ts.torque});
+  }
+  return out;
+}
+
+std::vector<ToolFrame> SceneSession::tool_frames() const { return impl_->tool_frames(impl_->sim->time()); }
+std::vector<ContactFrame> SceneSession::contact_frames() const {
+  return impl_->contact_frames(impl_->object_poses(impl_->sim->time()));
 }
 
 void SceneSession::record_frame(SimulationResult& r, double ms) const {

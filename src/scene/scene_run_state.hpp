@@ -32,6 +32,16 @@ struct SceneSession::Impl {
   /// a shape, then every tool's jaws (SceneSession::result_header's order).
   std::vector<Isometry> object_poses(double t) const;
 
+  /// Every tool's pose as drawn at time t, closure, force and torque.
+  std::vector<ToolFrame> tool_frames(double t) const;
+  /// Every contact term's (compiled.contact_terms) force, point, depth and
+  /// active samples from the last step's report; `poses`: object_poses at
+  /// the frame's time (where terms without a contact point act).
+  std::vector<ContactFrame> contact_frames(const std::vector<Isometry>& poses) const;
+  /// Where a contact term that reports no contact point is drawn: the
+  /// object's position for "contact:<object>", else its body's pelvis.
+  Vec3 fallback_contact_point(const Model::BoundTerm& term, const std::vector<Isometry>& poses) const;
+
   /// An object's pose at time t: its description's, or its rigid body's (dynamic).
   Isometry object_pose(const CompiledObject& o, double t) const {
     if (o.model_index < 0) return object_pose_at(*o.desc, t);

@@ -53,6 +53,7 @@ void SimulationResult::add_frame(FrameData fr) {
   frame_target_pelvis.push_back(fr.target_pelvis);
   for (size_t i = 0; i < fr.object_poses.size(); ++i) objects.at(i).poses.push_back(fr.object_poses[i]);
   for (size_t i = 0; i < fr.tools.size(); ++i) tools.at(i).frames.push_back(fr.tools[i]);
+  for (size_t i = 0; i < fr.contacts.size(); ++i) contacts.at(i).frames.push_back(fr.contacts[i]);
 }
 
 double SimulationResult::median_step_ms() const { return percentile(step_ms, 0.5); }

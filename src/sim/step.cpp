@@ -127,9 +127,12 @@ StepReport step_group(const Model& m, int gi, State& s, const StepInputs& inputs
     if (!t.active) continue;
     for (BoundBody& bb : t.ctx->bound) bb.q = &q[bb.slot];
     const int b0 = t.ctx->bound[0].body;
-    for (TermQuantity& v : t.term->report(*t.ctx, q[t.ctx->bound[0].slot]))
+    for (TermQuantity& v : t.term->report(*t.ctx, q[t.ctx->bound[0].slot])) {
+      // A point a term reports is in this step's centred frame: back to the world.
+      if (v.name == "contact_point" && v.value.size() == 3) v.value += c;
       rep.quantities.push_back({t.term->name(), b0, v.name, v.unit,
                                 std::vector<double>(v.value.data(), v.value.data() + v.value.size()), g.terms[k]});
+    }
   }
   for (size_t k = 0; k < g.bodies.size(); ++k) {
     const int b = g.bodies[k];

@@ -41,6 +41,17 @@ nlohmann::json tools_json(const std::vector<ToolFrame>& tools) {
   return a;
 }
 
+/// Every contact's force on its body (N), where it acts (m), its depth (mm) and active samples.
+nlohmann::json contacts_json(const std::vector<ContactFrame>& contacts) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const ContactFrame& c : contacts)
+    a.push_back({{"force", {c.force.x(), c.force.y(), c.force.z()}},
+                 {"point", {c.point.x(), c.point.y(), c.point.z()}},
+                 {"depth_mm", c.max_penetration * 1e3},
+                 {"active", c.active}});
+  return a;
+}
+
 std::string info_json(const ViewerFrame& f, const FrameEnvelope& e) {
   const ViewerStats& s = f.stats;
   nlohmann::json j;
@@ -69,6 +80,7 @@ std::string info_json(const ViewerFrame& f, const FrameEnvelope& e) {
                  {"contact", s.contact},
                  {"anchors", s.anchors}};
   if (!f.tools.empty()) j["tools"] = tools_json(f.tools);
+  if (!f.contacts.empty()) j["contacts"] = contacts_json(f.contacts);
   return j.dump();
 }
 

@@ -159,6 +159,8 @@ ViewerFrame LiveViewer::frame(const LiveRunStatus& status) const {
     f.joints.middleRows(24 * b, 24) = s.body_joints(b);
   }
   f.object_poses = s.object_poses();
+  f.tools = s.tool_frames();        // every tool's force arrow, not only the driven one's
+  f.contacts = s.contact_frames();  // every contact's force arrow
   ViewerStats& st = f.stats;
   st.rtf = status.rtf;
   st.step_ms = impl_->step_ms_avg;

@@ -21,6 +21,7 @@ ViewerFrame result_frame(const SimulationResult& r, int f) {
   if (f < int(r.frame_joints.size())) v.joints = r.frame_joints[f];
   for (const ObjectTrack& o : r.objects) v.object_poses.push_back(o.poses.at(f));
   for (const ToolTrack& t : r.tools) v.tools.push_back(t.frames.at(f));
+  for (const ContactTrack& c : r.contacts) v.contacts.push_back(c.frames.at(f));
   v.stats.frame_index = f;
   v.stats.max_displacement = v.displacement.size() ? v.displacement.maxCoeff() : 0.0;
   if (f < int(r.frame_step_ms.size())) v.stats.step_ms = r.frame_step_ms[f];

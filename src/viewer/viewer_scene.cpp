@@ -66,6 +66,7 @@ ViewerScene viewer_scene(const SimulationResult& r, const std::vector<std::strin
     s.tool_objects.push_back(found);
   }
   s.tool_events = r.tool_events;
+  for (const ContactTrack& c : r.contacts) s.contacts.push_back({c.term, c.body, {}});
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   double umax = 0;
   for (size_t f = 0; f < r.frame_positions.size(); ++f) {
@@ -117,6 +118,9 @@ std::string scene_json(const ViewerScene& s) {
   json tools = json::array();
   for (size_t t = 0; t < s.tools.size(); ++t) tools.push_back({{"name", s.tools[t]}, {"object", s.tool_objects[t]}});
   j["tools"] = tools;
+  json contacts = json::array();
+  for (const ContactTrack& c : s.contacts) contacts.push_back({{"term", c.term}, {"body", c.body}});
+  j["contacts"] = contacts;
   j["box_min"] = {s.box_min.x(), s.box_min.y(), s.box_min.z()};
   j["box_max"] = {s.box_max.x(), s.box_max.y(), s.box_max.z()};
   j["legend_max_mm"] = s.legend_max * 1e3;

@@ -78,6 +78,14 @@ TEST_F(SceneReference, TheFullFemDentsUnderAKinematicBallAndPushesItUp) {
   // The ball's frames follow its keyframes (held at y = 0.035 after 0.2 s).
   ASSERT_EQ(full.objects.size(), 1u);
   EXPECT_NEAR(full.objects[0].poses.back().translation().y(), 0.035, 1e-12);
+  // The result's contact is the reference's (its last frame is the last step), drawn at the ball.
+  ASSERT_EQ(full.contacts.size(), 1u);
+  EXPECT_EQ(full.contacts[0].term, "contact:ball");
+  ASSERT_EQ(full.contacts[0].frames.size(), 7u);
+  EXPECT_EQ(full.contacts[0].frames.back().force, st.pairs[0].last_force);
+  EXPECT_GT(full.contacts[0].frames.back().max_penetration, 0.0);
+  EXPECT_LE(full.contacts[0].frames.back().max_penetration, st.pairs[0].max_penetration);
+  EXPECT_NEAR(full.contacts[0].frames.back().point.y(), 0.035, 1e-12);
 }
 
 TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject) {

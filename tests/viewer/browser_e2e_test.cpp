@@ -6,7 +6,8 @@
 // is not blank; then the panel's controls: the stiffness slider reaches the
 // server, pause holds, step takes one solver step, reset goes back to t = 0
 // (tool at its start, no displacement). And `sflsh view` plays a result
-// file: the time advances, and the result's tool reaches the page.
+// file: the time advances, the result's tool reaches the page, and its
+// contact's force arrow is drawn.
 // Skips with a message when chromium, node or apps/viewer/node_modules is
 // absent (scripts/setup.sh installs them).
 #include <gtest/gtest.h>
@@ -189,6 +190,12 @@ TEST_F(BrowserE2E, ViewPlaysAResultFile) {
   EXPECT_NE(out.find("\"tools_in_frame\":1"), std::string::npos) << out;
   EXPECT_NE(out.find("\"tool_rows\":1"), std::string::npos) << out;
   EXPECT_NE(out.find("\"tools_panel\":true"), std::string::npos) << out;
+  // Its contact with the box (the probe ends 5 mm into it): a contact arrow in the last frame.
+  const nlohmann::json r = last_json_line(out);
+  EXPECT_EQ(r.value("contacts_in_scene", 0), 1) << out;
+  EXPECT_EQ(r.value("contact_arrows", 0), 1) << out;
+  ASSERT_TRUE(r.contains("contact_force") && r["contact_force"].is_array()) << out;
+  EXPECT_LT(double(r["contact_force"][1]), 0.0) << out;  // the probe pushes the body down
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // LiveViewer's controls over the WebSocket protocol, on a SceneSession of the
 // small box avatar: the stiffness slider's message reaches the session's
 // stiffness scale, reset sends it back to step 0 (unless the run writes files
-// along its time line), pause holds the state, and a step while paused is
-// exactly one solver step.
+// along its time line), pause holds the state, a step while paused is
+// exactly one solver step, and every tool's force and every contact reach the page.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -100,6 +100,45 @@ TEST_F(LiveControls, StiffnessAndResetReachTheSession) {
   EXPECT_EQ(info["resets"], 1);
   EXPECT_EQ(info["t"], 0.0);
   EXPECT_EQ(v.server().counters().controls_rejected, 1);
+}
+
+TEST_F(LiveControls, EveryToolsForceAndEveryContactReachThePage) {
+  if (!web_assets_problem().empty()) GTEST_SKIP() << web_assets_problem();
+  // Two probes 5 mm into the box's top (y = 0.03), a third one far above it.
+  SceneSession s(read_scene_description(write_scene(R"(
+solver: {dt: 1/250, seconds: 10}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - {name: left, shape: {type: sphere, radius: 0.005}, keyframes: [{time: 0.0, position: [-0.015, 0.03, 0.0]}]}
+  - {name: right, shape: {type: sphere, radius: 0.005}, keyframes: [{time: 0.0, position: [0.015, 0.03, 0.0]}]}
+  - {name: away, shape: {type: sphere, radius: 0.005}, keyframes: [{time: 0.0, position: [0.0, 0.5, 0.0]}]}
+)")),
+                 quiet_session());
+  LiveViewer v(s, quiet_server(), "box");
+  test::Client c(v.server().port());
+  const nlohmann::json scene = nlohmann::json::parse(c.read());
+  ASSERT_EQ(scene["contacts"].size(), 3u);
+  EXPECT_EQ(scene["contacts"][1]["term"], "contact:right");
+  for (int i = 0; i < 10; ++i) s.advance();
+  v.server().publish(v.frame(LiveRunStatus{}));
+  QuantizedSkin state;
+  const nlohmann::json info = next_info(c, v.server().scene(), &state);
+  ASSERT_EQ(info["tools"].size(), 3u);
+  ASSERT_EQ(info["contacts"].size(), 3u);
+  for (int t = 0; t < 3; ++t) {
+    const Vec3 tool(info["tools"][t]["force"][0], info["tools"][t]["force"][1], info["tools"][t]["force"][2]);
+    const Vec3 contact(info["contacts"][t]["force"][0], info["contacts"][t]["force"][1], info["contacts"][t]["force"][2]);
+    EXPECT_EQ(tool, s.tool_state(t).force) << "tool " << t;
+    // A tool without anchors feels what its contact exerts on the body, reversed.
+    EXPECT_LT((tool + contact).norm(), 1e-9 * (1 + tool.norm())) << "tool " << t;
+    if (t < 2) {  // pressed in: in contact, with a force
+      EXPECT_GT(info["contacts"][t]["active"].get<int>(), 0) << "tool " << t;
+      EXPECT_GT(contact.norm(), 0.0) << "tool " << t;
+    }
+  }
+  EXPECT_EQ(info["contacts"][2]["force"][1], 0.0);  // "away" touches nothing
+  EXPECT_GT(double(info["contacts"][1]["point"][0]), 0.005);  // "right" acts right of the centre
 }
 
 TEST_F(LiveControls, ResetIsIgnoredWhenTheRunWritesAlongItsTimeLine) {

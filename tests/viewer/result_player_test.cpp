@@ -1,8 +1,9 @@
 // Playback (`sflsh view`): the frame shown at time t is the result file's
 // frame at time t (the last frame at or before t), through the server and a
 // WebSocket client, to within the 16-bit quantization of positions; the
-// result's tools (pose, force, torque, closure per frame, grasp events) reach
-// the page with the values the file holds.
+// result's tools (pose, force, torque, closure per frame, grasp events) and
+// contacts (force, point, depth, samples per frame) reach the page with the
+// values the file holds.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -204,6 +205,50 @@ TEST(ResultPlayer, TheResultsToolsReachThePageWithTheFilesValues) {
     // The grip's surface and its jaw are posed by the frame's object poses.
     ASSERT_EQ(d.object_poses.size(), 2u);
     EXPECT_LE((d.object_poses[1].translation() - written.objects[1].poses[size_t(k)].translation()).norm(), 1e-6);
+  }
+}
+
+TEST(ResultPlayer, TheResultsContactsReachThePageWithTheFilesValues) {
+  if (!web_assets_problem().empty()) GTEST_SKIP() << web_assets_problem();
+  sflsh::test::TempDir dir;
+  SimulationResult written = four_frames();
+  written.contacts = {{"contact:floor", "body", {}}, {"self_contact", "body", {}}};
+  for (int k = 0; k < 4; ++k)
+    for (int c = 0; c < 2; ++c)
+      written.contacts[size_t(c)].frames.push_back(
+          {Vec3(0.5 + k, -2.0 * (c + 1), 0.25 * k), Vec3(0.01 * k, -0.02, 0.1 * c), 1e-3 * (k + 1) + c, 3 * k + c});
+  write_simulation_result(written, dir.file("r.h5"));
+  const SimulationResult r = read_simulation_result(dir.file("r.h5"));
+  ViewerServerOptions o;
+  o.port = 0;
+  o.quiet = true;
+  ViewerServer server(playback_scene(r, "r.h5"), o);
+  ResultPlayer player(r);
+  test::Client client(server.port());
+  const nlohmann::json scene = nlohmann::json::parse(client.read());
+  ASSERT_EQ(scene["contacts"].size(), 2u);
+  EXPECT_EQ(scene["contacts"][0]["term"], "contact:floor");
+  EXPECT_EQ(scene["contacts"][1]["term"], "self_contact");
+  EXPECT_EQ(scene["contacts"][1]["body"], "body");
+  QuantizedSkin state;
+  for (int k : {3, 1}) {
+    ControlMessage seek;
+    seek.type = ControlType::kSeek;
+    seek.value = 0.1 * k;
+    player.apply(seek);
+    server.publish(player.current());
+    const DecodedFrame d = decode_frame(client.read(), server.scene(), &state);
+    const nlohmann::json contacts = nlohmann::json::parse(d.info)["contacts"];
+    ASSERT_EQ(contacts.size(), 2u) << "frame " << k;
+    for (size_t c = 0; c < 2; ++c) {
+      const ContactFrame& w = written.contacts[c].frames[size_t(k)];
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_DOUBLE_EQ(contacts[c]["force"][i].get<double>(), w.force[i]) << "frame " << k << " contact " << c;
+        EXPECT_DOUBLE_EQ(contacts[c]["point"][i].get<double>(), w.point[i]) << "frame " << k << " contact " << c;
+      }
+      EXPECT_DOUBLE_EQ(contacts[c]["depth_mm"].get<double>(), w.max_penetration * 1e3) << "frame " << k;
+      EXPECT_EQ(contacts[c]["active"].get<int>(), w.active) << "frame " << k;
+    }
   }
 }
 

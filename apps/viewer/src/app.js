@@ -1,5 +1,6 @@
 // The sflsh viewer page: connects to the server's WebSocket, draws the skin
-// coloured by soft displacement, the objects, tools and skeleton, and sends
+// coloured by soft displacement, the objects, tools and skeleton, the tools'
+// and contacts' force arrows, and sends
 // the user's tool motion and controls (control messages:
 // include/sflsh/viewer/control_message.hpp).
 import * as THREE from 'three';
@@ -8,6 +9,7 @@ import { decodeFrame, makeState } from './protocol.js';
 import { ForcePlot, colormap, drawLegend } from './panels.js';
 import { ToolInput } from './tool_input.js';
 import { ResultTools } from './result_tools.js';
+import { ContactArrows, makeArrows, placeArrow } from './force_arrows.js';
 
 const $ = (id) => document.getElementById(id);
 // SMPL joint parents (24 joints per body).
@@ -16,6 +18,8 @@ const PARENTS = [-1, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 9, 9, 12, 13, 14, 16, 1
 // What tests and measurements read (window.sflshViewer).
 const stats = { frames: 0, rendered: 0, bytes: 0, latencies: [], lastInfo: null, scene: null, errors: [],
                 renderedFrame: -1, fps: 0, receivedFps: 0, bandwidth: 0, maxU: 0, contactFrames: 0,
+                // Contact force arrows visible in the last frame, and the most seen in one frame.
+                contactArrows: 0, maxContactArrows: 0,
                 // Page time (ms, summed) per stage: decoding frames, applying them (colours, panels), normals, draws.
                 timing: { decode_ms: 0, apply_ms: 0, normals_ms: 0, render_ms: 0, draws: 0 } };
 window.sflshViewer = stats;
@@ -66,6 +70,8 @@ let faces = null, skinDirty = false;  // skinDirty: positions changed since the 
 const objects = [];
 let toolInput = null, plot = null, arrow = null, driver = false, paused = false;
 let resultTools = null;  // playback: the result's tools
+let contactArrows = null;  // every contact's force on its body
+let otherToolArrows = [];  // live: the force arrows of the tools after the driven one
 let seq = 0;
 let lastResets = 0, stiffnessSentAt = -1e9;
 const sentAt = new Map();  // seq -> performance.now() at send, for input-to-photon
@@ -158,6 +164,8 @@ function buildScene(m) {
     toolInput = new ToolInput({ camera, dom: renderer.domElement, orbit, send, toolMesh: objects[m.tools[0].object],
                                 toolModeBox: $('toolmode') });
   }
+  if (live && m.tools.length > 1) otherToolArrows = makeArrows(scene3, m.tools.length - 1, 0xff4060);
+  contactArrows = new ContactArrows(scene3, m);
   if (!live && m.tools.length > 0) {
     $('resulttools').classList.remove('hidden');
     resultTools = new ResultTools({ scene3, meta: m, objects, table: $('tooltable'), events: $('toolevents'),
@@ -249,6 +257,16 @@ function applyFrame(f) {
 let panelsAt = -1e9;
 function showInfo(info) {
   if (resultTools && info.tools) resultTools.show(info.tools);
+  if (contactArrows) {
+    contactArrows.show(info.contacts);
+    stats.contactArrows = contactArrows.shown;
+    stats.maxContactArrows = Math.max(stats.maxContactArrows, contactArrows.shown);
+  }
+  // Live: the driven tool's arrow is below; every other tool's at its frame.
+  for (let t = 0; t < otherToolArrows.length && info.tools && t + 1 < info.tools.length; ++t) {
+    const pose = info.tools[t + 1].pose;
+    placeArrow(otherToolArrows[t], new THREE.Vector3(pose[0], pose[1], pose[2]), info.tools[t + 1].force);
+  }
   if (info.tool) {
     const F = new THREE.Vector3(...info.tool.force), n = F.length();
     if (plot) plot.push(info.t, info.tool.force);

@@ -4,18 +4,15 @@
 // readout of each tool's force and closure, and the list of grasps and
 // releases (click one to seek to it).
 import * as THREE from 'three';
-
-// Arrow length per newton (m/N) and its cap (m), as the live tool's arrow.
-const METRES_PER_NEWTON = 0.02, MAX_ARROW = 0.5;
+import { makeArrows, placeArrow } from './force_arrows.js';
 
 export class ResultTools {
   // scene3: the three.js scene; meta: the scene message; objects: its object meshes;
   // table, events: the page's readout table and event list; seek(t): sends a seek.
   constructor({ scene3, meta, objects, table, events, seek }) {
-    this.views = meta.tools.map((tool) => {
-      const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 1, 0), new THREE.Vector3(), 0.1, 0xff4060);
-      arrow.visible = false;
-      scene3.add(arrow);
+    const arrows = makeArrows(scene3, meta.tools.length, 0xff4060);
+    this.views = meta.tools.map((tool, t) => {
+      const arrow = arrows[t];
       let marker = null;
       if (!(tool.object >= 0 && objects[tool.object])) {
         // No surface: a 5 mm sphere with the tool frame's axes (3 cm).
@@ -53,14 +50,7 @@ export class ResultTools {
       p.set(s.pose[0], s.pose[1], s.pose[2]);
       q.set(s.pose[4], s.pose[5], s.pose[6], s.pose[3]);
       if (v.marker) v.marker.matrix.compose(p, q, one);
-      const F = new THREE.Vector3(...s.force), n = F.length();
-      v.arrow.visible = n > 1e-6;
-      if (v.arrow.visible) {
-        v.arrow.position.copy(p);
-        v.arrow.setDirection(F.normalize());
-        const len = Math.min(METRES_PER_NEWTON * n, MAX_ARROW);
-        v.arrow.setLength(len, Math.min(0.3 * len, 0.05), Math.min(0.15 * len, 0.025));
-      }
+      placeArrow(v.arrow, p, s.force);
     }
   }
 

@@ -8,7 +8,8 @@
 // in the view plane, holds, and reports what the server sent (contact, max |u|);
 // with --controls, then moves the stiffness slider to 10^0.5 ≈ 3.16×, pauses, steps, resets
 // and resumes with the page's controls and reports what the frames said;
-// playback: presses play and checks the time advances, and reports the result's tools.
+// playback: presses play and checks the time advances, and reports the result's tools; then
+// seeks to the last frame and reports the contact arrows drawn.
 // Always: display fps, bandwidth, input-to-photon latencies, pixel statistics of the rendered image.
 // Prints one JSON line; exits 1 when the page shows no frames or is blank.
 import fs from 'node:fs';
@@ -138,6 +139,17 @@ try {
                                                shown: !document.getElementById('resulttools').classList.contains('hidden') }));
     Object.assign(result, { tools_in_frame: (last.tools || []).length, tool_rows: panel.rows, tools_panel: panel.shown,
                             tool_pose: last.tools && last.tools.length ? last.tools[0].pose : null });
+    // The result's contacts: seek to the last frame (the probe pressed in) and count the arrows drawn.
+    await page.evaluate(() => {
+      const tl = document.getElementById('timeline');
+      tl.value = tl.max;
+      tl.dispatchEvent(new Event('input'));
+    });
+    await page.waitForFunction(() => window.sflshViewer.maxContactArrows > 0, { timeout: 5000 }).catch(() => {});
+    Object.assign(result, await page.evaluate(() => ({
+      contacts_in_scene: (window.sflshViewer.scene.contacts || []).length,
+      contact_arrows: window.sflshViewer.maxContactArrows,
+      contact_force: ((window.sflshViewer.lastInfo.contacts || [])[0] || {}).force || null })));
   }
   const s = await page.evaluate(() => {
     const v = window.sflshViewer, l = v.latencies.slice().sort((a, b) => a - b);

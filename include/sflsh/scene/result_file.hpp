@@ -49,6 +49,11 @@
 //                points (E,) int}      grasps and releases; only when there were any
 //   (the /tools, /frames/tool_* and /tool_events datasets are absent in files
 //   written before they existed, and in results without tools)
+//   /contacts/<c>/{term, body, force (Fr,3), point (Fr,3), max_penetration (Fr,),
+//                active_samples (Fr,)}   c = 0..C-1: every contact term's force on its body
+//                                      (N, world), where it acts (m), its deepest sample (m)
+//                                      and samples in contact, per frame (result_contacts.hpp).
+//                                      Only when C > 0; absent in older files (= no contacts).
 //   /steps/{time, energy, grad_norm, newton_decrement, outcome, ms}   (S,) per step
 //     outcome: 0 accepted, 1 damped, 2 rejected
 #include <memory>
@@ -68,9 +73,10 @@ struct ResultScene {
   std::vector<int> body_vertex_offsets; ///< #bodies + 1 entries, or empty with body_names
   std::vector<ObjectTrack> objects;     ///< name, shape, kind, vertices, faces (poses unused)
   std::vector<std::string> tool_names;  ///< the tools (frames come with each frame)
+  std::vector<ContactTrack> contacts;   ///< term and body of each contact (frames come with each frame)
 };
 
-/// The bodies, objects and tools of `result` (objects copied without their poses).
+/// The bodies, objects, tools and contacts of `result` (objects and contacts copied without their frames).
 ResultScene result_scene(const SimulationResult& result);
 
 /// Number of bodies of a result: body_names.size(), or 1 when that is empty.
@@ -97,7 +103,7 @@ class ResultWriter {
   ~ResultWriter();
   /// Appends a frame: positions and displacement #V by 3, joints 24·B by 3,
   /// reduced of num_reduced, one finite rigid pose per object, one finite
-  /// ToolFrame per tool. Throws naming
+  /// ToolFrame per tool, one finite ContactFrame per contact. Throws naming
   /// the path and the field on a size mismatch or a non-finite/non-rigid pose.
   void add_frame(const FrameData& frame);
   void finish(const SimulationResult& result);
@@ -115,6 +121,7 @@ class ResultWriter {
   Eigen::Index num_vertices_ = 0, num_joints_ = 24, num_reduced_ = 0;
   std::vector<std::string> object_names_;
   std::vector<std::string> tool_names_;
+  std::vector<ContactTrack> contacts_;  ///< term and body of each contact (no frames)
 };
 
 /// Writes a whole result; /frames/target_pelvis only when the result has it,

@@ -124,6 +124,11 @@ struct CompiledScene {
   std::vector<CompiledBody> bodies;    ///< scene order
   std::vector<CompiledObject> objects; ///< scene order
   std::vector<CompiledTool> tools;     ///< scene order
+  /// Model term indices of every contact term, in model order: body–object
+  /// pairs, the tools' shapes and jaws, then body–body skin and capsule pairs
+  /// and self contact (not the tools' anchors and couplings). What results
+  /// record per frame (SimulationResult::contacts).
+  std::vector<int> contact_terms;
 };
 
 /// Compiles `scene`. Throws sflsh::Error naming the scene file and the body,

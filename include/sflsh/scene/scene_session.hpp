@@ -173,15 +173,23 @@ class SceneSession {
   /// The result's constant part: every body's skin concatenated (surface,
   /// faces, body names and offsets), the objects' and tools' surfaces
   /// (objects first, then the tools with a shape), every tool's name
-  /// (SimulationResult::tools), no frames.
+  /// (SimulationResult::tools) and every contact term's name and body
+  /// (SimulationResult::contacts), no frames.
   SimulationResult result_header() const;
   /// Current poses of the result_header() objects, in its order (world).
   std::vector<Isometry> object_poses() const;
   /// The current state as an output frame (`step_ms`: the mean step time
   /// since the previous frame): every body's skin, displacement, joints and z,
   /// the first body's target pelvis (G_0 J̄_0 of its target bones), object
-  /// poses, each tool's pose, closure, force and torque.
+  /// poses, each tool's pose, closure, force and torque, each contact term's
+  /// force, point, depth and active samples.
   FrameData frame(double step_ms) const;
+  /// Every tool's current pose (as drawn), closure, force and torque, in
+  /// result_header().tools order.
+  std::vector<ToolFrame> tool_frames() const;
+  /// Every contact term's force, point, depth and active samples from the last
+  /// step (zero before the first), in result_header().contacts order.
+  std::vector<ContactFrame> contact_frames() const;
   /// Appends the current state as a frame of `result` (made by result_header()):
   /// frame(step_ms) added with add_frame(); sets result.tool_events to the events so far.
   void record_frame(SimulationResult& result, double step_ms) const;

@@ -76,6 +76,30 @@ struct ToolEvent {
   int points = 0;                ///< skin points anchored or let go
 };
 
+/// A contact term of a scene at one output frame: its report at the end of
+/// the step before the frame (zero before the first step and while the term
+/// is inactive).
+struct ContactFrame {
+  Vec3 force = Vec3::Zero();  ///< N, world: what the term exerts on its body
+  /// m, world: where it acts, the force-weighted mean of the term's active
+  /// samples (capsule pairs: of their witness midpoints). Without one (no
+  /// contact, or a term that reports none: the contact patch) the object's
+  /// position for "contact:<object>", else the body's pelvis (joint 0).
+  Vec3 point = Vec3::Zero();
+  double max_penetration = 0;  ///< m: deepest sample (capsules: largest overlap)
+  int active = 0;              ///< samples (capsule pairs) in contact
+};
+
+/// A contact term of a scene as results show it: body–object
+/// ("contact:<object>", tools' shapes and jaws too), body–body
+/// ("skin_contact", "body_contact") or "self_contact"; one ContactFrame per
+/// output frame. Tools' anchors are not contacts (their force is ToolFrame::force).
+struct ContactTrack {
+  std::string term;  ///< the term's name
+  std::string body;  ///< the body it acts on (its first body; the other one feels the opposite force)
+  std::vector<ContactFrame> frames;
+};
+
 /// One output frame (what the result file stores per frame).
 struct FrameData {
   double time = 0, step_ms = 0;
@@ -86,6 +110,7 @@ struct FrameData {
   Vec3 target_pelvis = Vec3::Zero();  ///< the motion's pelvis at `time` (world, m; first body)
   std::vector<Isometry> object_poses;  ///< one per SimulationResult::objects entry
   std::vector<ToolFrame> tools;        ///< one per SimulationResult::tools entry
+  std::vector<ContactFrame> contacts;  ///< one per SimulationResult::contacts entry
 };
 
 struct SimulationResult {
@@ -100,6 +125,9 @@ struct SimulationResult {
   /// events; empty without tools.
   std::vector<ToolTrack> tools;
   std::vector<ToolEvent> tool_events;
+  /// Contact terms of the scene (a frame per output frame); empty without
+  /// contacts and when read from a file written before they were stored.
+  std::vector<ContactTrack> contacts;
   double dt = 0;
   bool bones_dynamic = false;
   int newton_iters = 1;
@@ -130,8 +158,9 @@ struct SimulationResult {
   void add_step_times(const StepReport& report);
   /// Records a step ending at time t (s): the step_* series, its times and outcome counts.
   void add_step(double t, const StepReport& report);
-  /// Keeps an output frame: the frame_* series, each object's pose and each
-  /// tool's frame (num_frames and the pelvis figures are counted apart).
+  /// Keeps an output frame: the frame_* series, each object's pose, each
+  /// tool's and each contact's frame (num_frames and the pelvis figures are
+  /// counted apart).
   void add_frame(FrameData frame);
   /// Median / 95th percentile step wall time (ms).
   double median_step_ms() const;

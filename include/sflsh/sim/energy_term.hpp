@@ -104,7 +104,9 @@ struct StepContext {
 struct TermQuantity {
   std::string name;   ///< e.g. "contact_force"
   std::string unit;   ///< e.g. "N"
-  VecX value;         ///< the value (a vector; a scalar is one entry)
+  /// The value (a vector; a scalar is one entry). A "contact_point" (3, m) is
+  /// in the step's centred frame (step.hpp); StepReport holds it in the world.
+  VecX value;
 };
 
 class EnergyTerm {

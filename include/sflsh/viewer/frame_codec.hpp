@@ -25,8 +25,10 @@
 //           L   info      UTF-8 JSON: {"t","seq","driver","clients","paused","rtf","step_ms",
 //                         "terms":[[name, ms]...],"stiffness","resets","steps","max_u_mm","frame","speed",
 //                         "tool":{"force":[N],"device":[m],"quat":[w,x,y,z],"closure","contact","anchors"},
-//                         "tools":[{"pose":[px,py,pz,qw,qx,qy,qz],"force":[N],"torque":[N·m],"closure"}]}
-//                         ("tool": the driven tool, live; "tools": every tool, playback)
+//                         "tools":[{"pose":[px,py,pz,qw,qx,qy,qz],"force":[N],"torque":[N·m],"closure"}],
+//                         "contacts":[{"force":[N],"point":[m],"depth_mm","active"}]}
+//                         ("tool": the driven tool, live; "tools": every tool, live and playback;
+//                         "contacts": every ViewerScene contact, live and playback)
 // 16-bit positions keep a 2 m box to 0.03 mm and the default avatar (~9k
 // vertices) at 63 kB per full frame (1.9 MB/s at 30 fps); deltas are smaller
 // whenever part of the skin is still.
@@ -76,7 +78,8 @@ struct ViewerFrame {
   VecX displacement;            ///< #V soft displacement magnitudes |u| (m)
   Points joints;                ///< #J by 3 (m, world); may be empty
   std::vector<Isometry> object_poses;  ///< one per ViewerScene object
-  std::vector<ToolFrame> tools;        ///< playback: one per ViewerScene tool (pose, closure, force, torque)
+  std::vector<ToolFrame> tools;        ///< one per ViewerScene tool (pose, closure, force, torque)
+  std::vector<ContactFrame> contacts;  ///< one per ViewerScene contact (force on the body, point, depth, samples)
   ViewerStats stats;
 };
 

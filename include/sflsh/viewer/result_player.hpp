@@ -15,7 +15,7 @@ namespace sflsh::viewer {
 int frame_at(const std::vector<double>& frame_time, double t);
 
 /// Result frame `f` as a viewer frame: positions, |u| per vertex, joints, object poses,
-/// every tool's pose, closure, force and torque.
+/// every tool's pose, closure, force and torque, every contact's force, point, depth and samples.
 ViewerFrame result_frame(const SimulationResult& result, int f);
 
 class ResultPlayer {

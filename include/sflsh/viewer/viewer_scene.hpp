@@ -29,6 +29,8 @@ struct ViewerScene {
   std::vector<ViewerObject> objects;    ///< in the order of ViewerFrame::object_poses
   std::vector<std::string> tools;       ///< live: the drivable tools; playback: the result's tools (tool index order)
   std::vector<int> tool_objects;        ///< objects index of each tool's surface, -1 if none
+  /// The result's contact terms (ViewerFrame::contacts order): term and body, no frames.
+  std::vector<ContactTrack> contacts;
   /// Quantization box (m, world): frame positions are sent as 16-bit
   /// fractions of it and clamped to it.
   Vec3 box_min = Vec3::Zero(), box_max = Vec3::Ones();
@@ -42,7 +44,7 @@ struct ViewerScene {
 /// The scene of a result (or of SceneSession::result_header() with at least
 /// one recorded frame): skin, bodies, objects as object_display_meshes draws
 /// them (names and kinds from the result; `tool_names` mark the objects that
-/// are tools, by name, and their jaws "<tool>/jaw<j>"), and the result's tool events. The box holds every frame's skin and the objects'
+/// are tools, by name, and their jaws "<tool>/jaw<j>"), the result's contact terms and its tool events. The box holds every frame's skin and the objects'
 /// positions, padded by `pad` m (live scenes pad more: the body may move).
 /// legend_max = the largest |u| over the frames rounded up to 1 mm, at least
 /// `min_legend` m. Throws when the result has no frame.
@@ -56,6 +58,7 @@ ViewerScene playback_scene(const SimulationResult& result, const std::string& ti
 /// The scene as the JSON text sent on connect:
 /// {"type":"scene","mode","title","faces":[...flat],"rest":[...flat],"bodies":[{"name","begin","end"}],
 ///  "joints":J,"objects":[{"name","shape","kind","vertices":[...],"faces":[...]}],"tools":[{"name","object"}],
+///  "contacts":[{"term","body"}],
 ///  "box_min":[3],"box_max":[3],"legend_max_mm":x,"duration":s,"dt":s,"can_reset":b,"protocol":1,
 ///  "tool_events":[{"time","tool","body","kind","points"}]}
 std::string scene_json(const ViewerScene& scene);

@@ -144,7 +144,8 @@ std::vector<TermQuantity> CapsuleContactTerm::report(const StepContext& ctx, con
   const Configuration& qb = self_ ? q : *ctx.bound[1].q;
   Vec3 force = Vec3::Zero();
   int overlapping = 0;
-  double worst = 0;
+  double worst = 0, weight = 0;
+  Vec3 point = Vec3::Zero();
   for (int idx : c.near) {
     const auto [i, j] = pairs_[idx];
     const geometry::CapsuleContact cc = geometry::capsule_distance(posed(caps_a_[i], q.bones), posed(caps_b_[j], qb.bones));
@@ -152,9 +153,15 @@ std::vector<TermQuantity> CapsuleContactTerm::report(const StepContext& ctx, con
     force += options_.stiffness * cc.distance * cc.normal;  // −k d (−n): pushes a away from b
     ++overlapping;
     worst = std::max(worst, -cc.distance);
+    // Between the two witness points, weighted by the pair's force k|d|.
+    point += -cc.distance * 0.5 * (cc.witness_a + cc.witness_b);
+    weight += -cc.distance;
   }
-  return {{"force", "N", force}, {"overlapping_pairs", "", VecX::Constant(1, overlapping)},
-          {"max_overlap", "m", VecX::Constant(1, worst)}};
+  std::vector<TermQuantity> out = {{"force", "N", force},
+                                   {"overlapping_pairs", "", VecX::Constant(1, overlapping)},
+                                   {"max_overlap", "m", VecX::Constant(1, worst)}};
+  if (weight > 0) out.push_back({"contact_point", "m", point / weight});
+  return out;
 }
 
 }  // namespace sflsh

@@ -307,16 +307,24 @@ std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const C
     }
   }
   force += friction_force;
+  Vec3 point = Vec3::Zero();
+  double weight = 0;
   for (int p : cand) {
-    const geometry::SdfSample s = field_->evaluate(T_inv * samples_.world_point(p, q));
+    const Vec3 x = samples_.world_point(p, q);
+    const geometry::SdfSample s = field_->evaluate(T_inv * x);
     if (!(s.distance < 0)) continue;
     force -= options_.stiffness * s.distance * (T.linear() * s.gradient);
     ++active;
     depth = std::max(depth, -s.distance);
+    // The active samples' mean, weighted by their normal force k|d|.
+    point -= s.distance * x;
+    weight -= s.distance;
   }
-  return {{"force", "N", force}, {"friction_force", "N", friction_force},
-          {"active_samples", "", VecX::Constant(1, active)},
-          {"max_penetration", "m", VecX::Constant(1, depth)}};
+  std::vector<TermQuantity> out = {{"force", "N", force}, {"friction_force", "N", friction_force},
+                                   {"active_samples", "", VecX::Constant(1, active)},
+                                   {"max_penetration", "m", VecX::Constant(1, depth)}};
+  if (weight > 0) out.push_back({"contact_point", "m", point / weight});
+  return out;
 }
 
 PosedPoints skin_contact_samples(const Avatar& avatar, double spacing, int max_handles, double* max_dropped) {

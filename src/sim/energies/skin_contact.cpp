@@ -294,7 +294,8 @@ std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const 
   const double half_kappa = 0.5 * options_.pressure_stiffness;
   Vec3 force = Vec3::Zero();
   int active = 0;
-  double worst = 0, area = 0;
+  double worst = 0, area = 0, weight = 0;
+  Vec3 point = Vec3::Zero();
   for (const Pair& p : c.pairs) {
     const int from = p.side;
     const double g = gap(p, c, x);
@@ -305,11 +306,18 @@ std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const 
     ++active;
     worst = std::max(worst, -g);
     area += 0.5 * p.area;
+    Vec3 sample = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) sample += p.lambda[i] * x[from].row(c.slot[from][skins_[from].faces(p.face, i)]).transpose();
+    point += on_sample.norm() * sample;
+    weight += on_sample.norm();
   }
-  return {{"force", "N", force},
-          {"active_samples", "", VecX::Constant(1, active)},
-          {"max_penetration", "m", VecX::Constant(1, worst)},
-          {"contact_area", "m^2", VecX::Constant(1, area)}};
+  std::vector<TermQuantity> out = {{"force", "N", force},
+                                   {"active_samples", "", VecX::Constant(1, active)},
+                                   {"max_penetration", "m", VecX::Constant(1, worst)},
+                                   {"contact_area", "m^2", VecX::Constant(1, area)}};
+  // Where the pressure acts: the samples' mean, weighted by their force (only while in contact).
+  if (weight > 0) out.push_back({"contact_point", "m", point / weight});
+  return out;
 }
 
 }  // namespace sflsh

@@ -47,7 +47,9 @@ class CapsuleContactTerm : public EnergyTerm {
   bool active(const StepContext& ctx) const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
   /// "force" (3, N: on the first body, world), "overlapping_pairs" (1),
-  /// "max_overlap" (1, m) at the final q.
+  /// "max_overlap" (1, m) at the final q; while any pair overlaps also
+  /// "contact_point" (3, m, world: the midpoints of the pairs' witness points,
+  /// weighted by their overlap).
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
   const CapsuleContactOptions& options() const { return options_; }

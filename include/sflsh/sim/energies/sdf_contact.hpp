@@ -90,7 +90,9 @@ class SdfContactTerm : public EnergyTerm {
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
   /// "force" (3, N: what the object exerts on the body, world; normal and
   /// friction), "friction_force" (3, N, its friction part), "active_samples"
-  /// (1: samples with φ < 0) and "max_penetration" (1, m) at the final q.
+  /// (1: samples with φ < 0) and "max_penetration" (1, m) at the final q;
+  /// while any sample is in contact also "contact_point" (3, m, world: the
+  /// active samples' mean weighted by their normal force k|φ|).
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
   const PosedPoints& samples() const { return samples_; }

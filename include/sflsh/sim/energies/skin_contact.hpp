@@ -74,7 +74,9 @@ class SkinContactTerm : public EnergyTerm {
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
   /// "force" (3, N: what b exerts on a, world), "active_samples" (1: samples
   /// with g < 0), "max_penetration" (1, m) and "contact_area" (1, m², rest
-  /// area of the samples in contact) at the final q.
+  /// area of the samples in contact) at the final q; while any sample is in
+  /// contact also "contact_point" (3, m, world: the active samples' mean
+  /// weighted by their pressure force).
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
   const SkinContactOptions& options() const { return options_; }
