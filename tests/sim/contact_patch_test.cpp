@@ -94,6 +94,15 @@ TEST(ContactPatch, UniformPenetrationGivesPressureStiffnessTimesDepthTimesArea) 
     EXPECT_NEAR(quantity(r, "force", 0), 0.0, 1e-12);
     EXPECT_NEAR(quantity(r, "max_penetration"), depth, 1e-12);
     EXPECT_NEAR(quantity(r, "contact_area"), area, 1e-12 * area) << spacing;
+    // A uniform pressure acts at the face's centre (the top face's box: 6 cm × 4 cm at y = 3 cm).
+    Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+    for (int f = 0; f < a.surface_faces.rows(); ++f)
+      for (int i = 0; i < 3; ++i) {
+        lo = lo.cwiseMin(Vec3(a.surface_rest.row(a.surface_faces(f, i)).transpose()));
+        hi = hi.cwiseMax(Vec3(a.surface_rest.row(a.surface_faces(f, i)).transpose()));
+      }
+    ASSERT_NEAR(hi.x() - lo.x(), 0.06, 1e-12);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(quantity(r, "contact_point", k), 0.5 * (lo[k] + hi[k]), 1e-9) << spacing;
     EXPECT_NEAR(term.evaluate(ctx, ctx.q_prev, nullptr, nullptr), 0.5 * kappa * depth * depth * area,
                 1e-9 * kappa * depth * depth * area);
   }

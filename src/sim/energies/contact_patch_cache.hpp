@@ -22,6 +22,8 @@ struct ContactPatchTerm::Evaluation {
   MatX Hqp;  // cross block (layout rows by patch DoFs)
   MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q Hessian)
   Vec3 force = Vec3::Zero();
+  Vec3 point_sum = Vec3::Zero();  // Σ |f_s| x_s over the touching samples (world, m·N)
+  double point_weight = 0;        // Σ |f_s|
   int active = 0;
   double depth = 0, area = 0;
 };

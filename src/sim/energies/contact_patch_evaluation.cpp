@@ -323,6 +323,8 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       const Vec3 nrm = T.linear() * sd.gradient;
       E += 0.5 * k * d * d;
       out.force -= k * d * nrm;
+      out.point_sum -= k * d * x;
+      out.point_weight -= k * d;
       ++out.active;
       out.depth = std::max(out.depth, -d);
       out.area += smp.area;

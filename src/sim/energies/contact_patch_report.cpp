@@ -29,7 +29,7 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
     max_du = std::max(max_du, h.du_next.norm());
     packed.segment<4>(4 * i) << double(n), h.du_next;
   }
-  return {{"force", "N", ev.force},
+  std::vector<TermQuantity> out = {{"force", "N", ev.force},
           {"active_samples", "", VecX::Constant(1, ev.active)},
           {"max_penetration", "m", VecX::Constant(1, ev.depth)},
           {"contact_area", "m^2", VecX::Constant(1, ev.area)},
@@ -38,6 +38,9 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
           {"patch_displacement", "m", packed},
           {"patch_iterations", "", VecX::Constant(1, c.inner_iterations)},
           {"patch_minimizations", "", VecX::Constant(1, c.minimizations)}};
+  // Where the force acts: the touching samples' mean weighted by their force.
+  if (ev.point_weight > 0) out.push_back({"contact_point", "m", ev.point_sum / ev.point_weight});
+  return out;
 }
 
 Points patch_surface_displacement(const Avatar& a, const StepReport& report, int body) {

@@ -130,7 +130,8 @@ class ContactPatchTerm : public EnergyTerm {
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
   /// "force" (3, N, what the object exerts on the body, world), "active_samples",
   /// "max_penetration" (m), "contact_area" (m²), "patch_nodes", "max_patch_displacement" (m),
-  /// "patch_displacement" (4 per patch node: the node's index, then its δu, m, unposed);
+  /// "patch_displacement" (4 per patch node: the node's index, then its δu, m, unposed),
+  /// "contact_point" (3, m: the touching samples' mean weighted by their force; only in contact);
   /// also fixes the patch displacement of the step (header comment).
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
