@@ -356,7 +356,7 @@ TEST_F(SceneCompileGolden, ContactPatchWithKinematicAndCoupledTools) {
   check({kPatchScene, nullptr, 20,
          {"inertia@0; elastic@0; gravity@0; contact:floor@0; contact:probe@0; bone_inertia@1; coupling:pusher@1; contact:pusher@0,1",
           "base:0/24/18@0 pusher:1/1/0@18 dofs 24 blocks 2 groups 1",
-          "857200a00cfd8c45", "ba504f43fc23ef0b", "e69ef3d09758e197", 0}});
+          "857200a00cfd8c45", "ba504f43fc23ef0b", "fdb8554419f4362f", 0}});
 }
 
 TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
