@@ -230,15 +230,21 @@ struct QuarticTerm : EnergyTerm {
   }
 };
 
+/// A system of three soft DoFs and no bones (the quartic tests below).
+StepContext three_soft_dofs() {
+  StepContext ctx;
+  ctx.layout.bones_dynamic = false;
+  ctx.layout.num_bones = 0;
+  ctx.layout.num_reduced = 3;
+  return ctx;
+}
+
 /// NewtonOptions::nonlinearity_tolerance. From z = 0 the Newton step is f/a; the energy falls by
 /// ½ f²/a − ¼ b f⁴/a⁴ against the model's ½ f²/a, so ρ = 1 − ½ b f²/a³ (by hand): 0.9 for
 /// a = f = 1, b = 0.2. Then the second iteration goes from 1 to 1 − (1 + 0.2 − 1)/(1 + 0.6) =
 /// 0.875. A quadratic (b = 0) has ρ = 1 and takes no second iteration.
 TEST(Newton, AFullStepFarFromItsQuadraticModelGetsOneMoreIteration) {
-  StepContext ctx;
-  ctx.layout.bones_dynamic = false;
-  ctx.layout.num_bones = 0;
-  ctx.layout.num_reduced = 3;
+  const StepContext ctx = three_soft_dofs();
   QuarticTerm term;
   term.b = 0.2;
   NewtonOptions o;
@@ -272,10 +278,7 @@ TEST(Newton, AFullStepFarFromItsQuadraticModelGetsOneMoreIteration) {
 /// (z = 1/2 exactly). The other way round (Q quartic, U = ½z² left out) Q
 /// departs from its model by 1/16 = ¼ of the predicted decrease: added.
 TEST(Newton, TermsLeftOutOfTheNonlinearityCheckDoNotAddIterations) {
-  StepContext ctx;
-  ctx.layout.bones_dynamic = false;
-  ctx.layout.num_bones = 0;
-  ctx.layout.num_reduced = 3;
+  const StepContext ctx = three_soft_dofs();
   NewtonOptions o;
   o.max_z_step = 0;
   o.nonlinearity_tolerance = 0.05;
