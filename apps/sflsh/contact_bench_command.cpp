@@ -33,6 +33,7 @@ struct ContactBenchArgs {
   std::optional<double> nonlinearity_tolerance;
   double pressure_stiffness = kDefaultPressureStiffness, spacing = kDefaultContactSpacing;
   double patch_radius = ContactPatchOptions().patch_radius;
+  int max_patch_nodes = ContactPatchOptions().max_patch_nodes;
   bool no_patch = false, cpu_time = false;
   std::string command_line;
 };
@@ -68,6 +69,7 @@ void run_contact_bench(const ContactBenchArgs& a) {
   o.settings.spacing = a.spacing;
   o.settings.patch = !a.no_patch;
   o.settings.patch_radius = a.patch_radius;
+  o.settings.max_patch_nodes = a.max_patch_nodes;
   o.settings.cpu_time = a.cpu_time;
   check_contact_sampling(a.pressure_stiffness, a.spacing, "bench-contact (--pressure-stiffness, --spacing)");
   require(std::isfinite(a.patch_radius) && a.patch_radius > 0, "--patch-radius must be a positive number of m, got ",
@@ -201,6 +203,10 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--patch-radius", a->patch_radius, "Radius of the full-space patch under a contact (m)")
       ->capture_default_str();
+  cmd->add_option("--max-patch-nodes", a->max_patch_nodes,
+                  "Nodes in one patch at most (beyond, the nodes nearest the deepest contact are kept)")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   cmd->add_flag("--no-patch", a->no_patch, "Contact on the reduced subspace alone (no full-space patch)");
   cmd->add_flag("--cpu-time", a->cpu_time,
                 "The ms columns in CPU time of the stepping thread (robust to other jobs' load), not wall time");
@@ -209,7 +215,8 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
   cmd->add_option("--out", a->out, "Output folder (contact_bench.csv, contact_bench.md)")->capture_default_str();
   cmd->callback([a, cmd] {
     for (const char* flag : {"--quick", "--model", "--betas", "--handles", "--nonlinearity-tolerance", "--newton-iters",
-                             "--pressure-stiffness", "--spacing", "--patch-radius", "--no-patch", "--no-cache"})
+                             "--pressure-stiffness", "--spacing", "--patch-radius", "--max-patch-nodes", "--no-patch",
+                             "--no-cache"})
       if (a->builtin_only_flag.empty() && cmd->count(flag) > 0) a->builtin_only_flag = flag;
     std::string handles;
     for (size_t i = 0; i < a->handles.size(); ++i) handles += (i ? "," : " --handles ") + std::to_string(a->handles[i]);
@@ -229,6 +236,8 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
     if (a->spacing != kDefaultContactSpacing) a->command_line += " --spacing " + std::to_string(a->spacing);
     if (a->patch_radius != ContactPatchOptions().patch_radius)
       a->command_line += " --patch-radius " + std::to_string(a->patch_radius);
+    if (a->max_patch_nodes != ContactPatchOptions().max_patch_nodes)
+      a->command_line += " --max-patch-nodes " + std::to_string(a->max_patch_nodes);
     for (const std::string& f : a->scene_files) a->command_line += " --scene " + f;
     run_contact_bench(*a);
   });

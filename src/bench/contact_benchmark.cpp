@@ -211,6 +211,7 @@ Trace run_reduced(std::shared_ptr<const Avatar> avatar, const Scene& sc, const S
     co.spacing = o.spacing;
     co.patch = o.patch;
     co.patch_radius = o.patch_radius;
+    co.max_patch_nodes = o.max_patch_nodes;
     co.subspace_mean_dilatation = o.mean_dilatation;
     mb.add_term(std::make_shared<const ContactPatchTerm>(kObject, *avatar, std::make_shared<geometry::SphereSdf>(sc.radius),
                                                          Isometry::Identity(), false, co),

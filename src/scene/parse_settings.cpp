@@ -27,9 +27,10 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
     if (v.IsScalar()) {
       c.patch = p.boolean(v, pk);
     } else {
-      p.check_map(v, pk, {"radius", "pressure_stiffness", "spacing"}, "the contact patch settings");
+      p.check_map(v, pk, {"radius", "max_nodes", "pressure_stiffness", "spacing"}, "the contact patch settings");
       c.patch = true;
       if (const auto r = v["radius"]) c.patch_radius = p.positive(r, pk + ".radius");
+      if (const auto r = v["max_nodes"]) c.max_patch_nodes = p.integer(r, pk + ".max_nodes", 1, 1000000);
       if (const auto r = v["pressure_stiffness"]) c.pressure_stiffness = p.positive(r, pk + ".pressure_stiffness");
       if (const auto r = v["spacing"]) c.patch_spacing = p.positive(r, pk + ".spacing");
     }

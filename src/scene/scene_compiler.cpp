@@ -136,6 +136,7 @@ int add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::string
     po.pressure_stiffness = c.pressure_stiffness;
     po.spacing = c.patch_spacing;
     po.patch_radius = c.patch_radius;
+    po.max_patch_nodes = c.max_patch_nodes;
     term = std::make_shared<const ContactPatchTerm>(frame, *b.avatar, field, shape_in_body, dynamic, po);
   } else {
     auto& pts = samples[b.avatar.get()];

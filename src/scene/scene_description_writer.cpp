@@ -186,7 +186,8 @@ std::string scene_description_yaml(const SceneDescription& scene) {
     << YAML::Value << num(c.sample_spacing);
   if (c.patch)
     e << YAML::Key << "patch" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "radius" << YAML::Value
-      << num(c.patch_radius) << YAML::Key << "pressure_stiffness" << YAML::Value << num(c.pressure_stiffness)
+      << num(c.patch_radius) << YAML::Key << "max_nodes" << YAML::Value << c.max_patch_nodes
+      << YAML::Key << "pressure_stiffness" << YAML::Value << num(c.pressure_stiffness)
       << YAML::Key << "spacing" << YAML::Value << num(c.patch_spacing) << YAML::EndMap;
   e << YAML::Key << "bodies" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "model" << YAML::Value
     << (c.body_model == ContactDescription::BodyModel::Skin ? "skin" : "capsules") << YAML::Key << "pressure_stiffness"

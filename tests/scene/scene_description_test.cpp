@@ -586,11 +586,13 @@ TEST(SceneDescription, ContactPatchKeysParseWriteBackAndRefuseBadValues) {
   const SceneDescription off = parse_scene_description(body, folder.file("off.yaml"));
   EXPECT_FALSE(off.contact.patch);
   const SceneDescription on = parse_scene_description(
-      body + "contact: {friction: 0, patch: {radius: 0.03, pressure_stiffness: 5.0e7, spacing: 0.003}}\n",
+      body + "contact: {friction: 0, patch: {radius: 0.03, max_nodes: 777, pressure_stiffness: 5.0e7, spacing: 0.003}}\n",
       folder.file("on.yaml"));
   const ContactDescription d;
   EXPECT_TRUE(on.contact.patch);
   EXPECT_EQ(on.contact.patch_radius, 0.03);
+  EXPECT_EQ(on.contact.max_patch_nodes, 777);
+  EXPECT_NE(d.max_patch_nodes, 777);
   EXPECT_EQ(on.contact.pressure_stiffness, 5.0e7);
   EXPECT_EQ(on.contact.patch_spacing, 0.003);
   EXPECT_NE(on.contact.patch_radius, d.patch_radius);
@@ -599,11 +601,15 @@ TEST(SceneDescription, ContactPatchKeysParseWriteBackAndRefuseBadValues) {
   const SceneDescription again = parse_scene_description(scene_description_yaml(on), folder.file("again.yaml"));
   EXPECT_TRUE(again.contact.patch);
   EXPECT_EQ(again.contact.patch_radius, 0.03);
+  EXPECT_EQ(again.contact.max_patch_nodes, 777);
   EXPECT_EQ(again.contact.pressure_stiffness, 5.0e7);
   EXPECT_EQ(again.contact.patch_spacing, 0.003);
   EXPECT_TRUE(parse_scene_description(body + "contact: {friction: 0, patch: true}\n", folder.file("t.yaml")).contact.patch);
   expect_scene_error(body + "contact: {patch: true}\n", {"scene.yaml:5:", "contact.patch", "frictionless", "friction: 0"});
   expect_scene_error(body + "contact: {friction: 0, patch: {radius: 0}}\n", {"scene.yaml:5:", "contact.patch.radius"});
+  expect_scene_error(body + "contact: {friction: 0, patch: {max_nodes: 0}}\n", {"scene.yaml:5:", "contact.patch.max_nodes"});
+  expect_scene_error(body + "contact: {friction: 0, patch: {max_nodes: 2.5}}\n",
+                     {"scene.yaml:5:", "contact.patch.max_nodes", "integer"});
   expect_scene_error(body + "contact: {friction: 0, patch: {pressure_stiffness: -1}}\n",
                      {"scene.yaml:5:", "contact.patch.pressure_stiffness"});
   expect_scene_error(body + "contact: {friction: 0, patch: maybe}\n", {"scene.yaml:5:", "contact.patch", "true or false"});

@@ -361,6 +361,43 @@ TEST(ContactPatch, ThePatchIsTheSimulatedNodesWithinItsRadiusOfTheNearSkin) {
   }
 }
 
+TEST(ContactPatch, ABroadContactGrowsThePatchToAMultipleOfTheContactRadius) {
+  // A half-space 1 mm into the slab's whole top face: the touching skin is
+  // its 7 × 5 vertices (1 cm apart), whose spread is 4 cm² along x and 2 cm²
+  // along z (a uniform lattice of n points h apart: (n² − 1) h² / 12). The
+  // contact radius is 2 σ₂ = 2 √2 cm, and the patch's radius 1.5 times that,
+  // 4.243 cm, over the 1 cm given; with the factor 0 it stays 1 cm. Either
+  // way the patch is every Simulated node within it of a near vertex.
+  const Avatar a = slab(4);
+  std::map<std::string, WorldFrame> frames;
+  frames["floor"].pose.linear() = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix();  // normal −y
+  frames["floor"].pose.translation() = Vec3(0, 0.03 - 0.001, 0);
+  for (double factor : {1.5, 0.0}) {
+    ContactPatchOptions o;
+    o.patch_radius = 0.01;
+    o.patch_radius_per_contact_radius = factor;
+    o.max_patch_nodes = 100000;
+    const ContactPatchTerm term("floor", a, std::make_shared<geometry::PlaneSdf>(Vec3(0, 1, 0), 0.0),
+                                Isometry::Identity(), false, o);
+    StepContext ctx = context(a, &frames, false);
+    const auto cache = begin_term_step(term, ctx);
+    const auto r = term.report(ctx, ctx.q_prev);
+    const double radius = factor > 0 ? 1.5 * 2.0 * std::sqrt(2.0) * 0.01 : 0.01;
+    EXPECT_NEAR(quantity(r, "patch_radius"), radius, 1e-12) << factor;
+    std::vector<Vec3> near;  // the top face, and the side vertices within the margin of the plane
+    for (int v = 0; v < a.surface_rest.rows(); ++v)
+      if (0.029 - a.surface_rest(v, 1) < o.margin) near.push_back(a.surface_rest.row(v).transpose());
+    int expected = 0;
+    for (int n = 0; n < a.tet.num_nodes(); ++n) {
+      if (a.node_role[n] != int(NodeRole::Simulated)) continue;
+      bool within = false;
+      for (const Vec3& x : near) within = within || (a.tet.nodes.row(n).transpose() - x).norm() <= radius;
+      expected += within;
+    }
+    EXPECT_EQ(quantity(r, "patch_nodes"), expected) << factor;
+  }
+}
+
 TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFiniteDifferences) {
   // The slab (bones kinematic, 6 handles) and a ball as a rigid body bound
   // second: the term's local system is [z (18) | ball (6)].
@@ -452,7 +489,9 @@ TEST(ContactPatch, TheSkinTakesItsTetsNodesPatchDisplacementBarycentrically) {
   for (int w = 0; w < u.rows(); ++w) {
     bool touched = false;
     for (int c = 0; c < 4; ++c) touched |= a.tet.elements(a.surface_tet[w], c) == n0 || a.tet.elements(a.surface_tet[w], c) == n2;
-    if (!touched) EXPECT_TRUE(u.row(w).isZero()) << "vertex " << w;
+    if (!touched) {
+      EXPECT_TRUE(u.row(w).isZero()) << "vertex " << w;
+    }
   }
   EXPECT_TRUE(patch_surface_displacement(a, StepReport(), 0).isZero());
   StepReport bad;
@@ -475,6 +514,11 @@ TEST(ContactPatch, BadOptionsAreRefusedNamingTheContact) {
     ContactPatchOptions o;
     o.patch_radius = r;
     test::expect_error([&] { make(o); }, {"contact with 'probe'", "patch radius"});
+  }
+  for (double f : {-1.0, double(NAN)}) {
+    ContactPatchOptions o;
+    o.patch_radius_per_contact_radius = f;
+    test::expect_error([&] { make(o); }, {"contact with 'probe'", "patch_radius_per_contact_radius"});
   }
   ContactPatchOptions o;
   o.spacing = 0;

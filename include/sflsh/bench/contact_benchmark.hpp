@@ -79,6 +79,7 @@ struct ContactBenchSettings {
   double spacing = kDefaultContactSpacing;
   bool patch = true;
   double patch_radius = ContactPatchOptions().patch_radius;
+  int max_patch_nodes = ContactPatchOptions().max_patch_nodes;
   std::vector<std::string> scenes;   ///< which scenes to run (empty: pressed, impact, probe)
   /// The ms columns: the stepping thread's CPU time instead of wall time (on a
   /// shared machine other jobs' load inflates wall time, not CPU time).

@@ -289,6 +289,7 @@ struct ContactDescription {
   /// coupled tools keep the per-sample penalty.
   bool patch = false;
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
+  int max_patch_nodes = ContactPatchOptions().max_patch_nodes;
   double pressure_stiffness = kDefaultPressureStiffness;      ///< N/m³
   double patch_spacing = kDefaultContactSpacing;              ///< m, face sample spacing
   /// contact.bodies: how two bodies meet. Skin (default): skin against skin

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <tuple>
 
+#include <Eigen/Eigenvalues>
+
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/rotation.hpp"
 #include "sflsh/fem/tet_operators.hpp"
@@ -42,6 +44,8 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   require(o.max_inner_iterations >= 1 && o.inner_tolerance >= 0 && o.release_displacement >= 0, what,
           ": inner iterations must be >= 1 and the tolerances >= 0");
   require(o.max_patch_nodes >= 1, what, ": max_patch_nodes ", o.max_patch_nodes, ", expected >= 1");
+  require(std::isfinite(o.patch_radius_per_contact_radius) && o.patch_radius_per_contact_radius >= 0, what,
+          ": patch_radius_per_contact_radius ", o.patch_radius_per_contact_radius, ", expected a finite number >= 0");
   vertices_ = PosedPoints::at_surface(a);
   if (o.max_handles > 0) vertices_ = vertices_.with_truncated_rows(o.max_handles);
   const int N = a.tet.num_nodes(), T = a.tet.num_elements();
@@ -134,8 +138,27 @@ void ContactPatchTerm::select_patch_nodes(TermCache& cache, const std::vector<in
   auto add_node = [&](int n) {
     if (c.node_slot.emplace(n, int(c.nodes.size())).second) c.nodes.push_back(n);
   };
+  c.radius = options_.patch_radius;
   if (options_.patch) {
-    const double r2 = options_.patch_radius * options_.patch_radius;
+    // The contact's radius a = 2 σ₂ (options): the middle principal spread
+    // of the seeds that touch at time t (φ < 0).
+    std::vector<int> touching;
+    for (size_t i = 0; i < seeds.size(); ++i)
+      if (seed_phi[i] < 0) touching.push_back(seeds[i]);
+    if (options_.patch_radius_per_contact_radius > 0 && touching.size() >= 3) {
+      Vec3 mean = Vec3::Zero();
+      for (int v : touching) mean += a.surface_rest.row(v).transpose();
+      mean /= double(touching.size());
+      Mat3 cov = Mat3::Zero();
+      for (int v : touching) {
+        const Vec3 d = a.surface_rest.row(v).transpose() - mean;
+        cov += d * d.transpose();
+      }
+      cov /= double(touching.size());
+      const Vec3 ev = Eigen::SelfAdjointEigenSolver<Mat3>(cov, Eigen::EigenvaluesOnly).eigenvalues();  // increasing
+      c.radius = std::max(c.radius, options_.patch_radius_per_contact_radius * 2.0 * std::sqrt(std::max(ev[1], 0.0)));
+    }
+    const double r2 = c.radius * c.radius;
     if (!seeds.empty()) {
       // Bounding box of the seeds first: most nodes are far.
       Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
@@ -143,8 +166,8 @@ void ContactPatchTerm::select_patch_nodes(TermCache& cache, const std::vector<in
         lo = lo.cwiseMin(Vec3(a.surface_rest.row(v).transpose()));
         hi = hi.cwiseMax(Vec3(a.surface_rest.row(v).transpose()));
       }
-      lo.array() -= options_.patch_radius;
-      hi.array() += options_.patch_radius;
+      lo.array() -= c.radius;
+      hi.array() += c.radius;
       // Each node within the radius, ranked by its distance to a seed
       // plus that vertex's φ: the deepest contact's nodes first when the patch
       // is over max_patch_nodes (a broad press).

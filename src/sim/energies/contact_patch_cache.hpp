@@ -46,6 +46,7 @@ struct PatchCache : TermCache {
   std::vector<int> face_first;                 // samples of faces[i]: [face_first[i], face_first[i+1])
   std::vector<int> vertices;                   // distinct vertices of the candidate faces
   std::unordered_map<int, int> vertex_slot;    // vertex → index into `vertices`
+  double radius = 0;                           // this step's patch radius (m, ContactPatchOptions)
   std::vector<int> nodes;                      // patch nodes
   std::unordered_map<int, int> node_slot;      // node → index into `nodes`
   std::vector<int> tets;                       // tets with a patch node

@@ -34,6 +34,7 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
           {"max_penetration", "m", VecX::Constant(1, ev.depth)},
           {"contact_area", "m^2", VecX::Constant(1, ev.area)},
           {"patch_nodes", "", VecX::Constant(1, double(c.nodes.size()))},
+          {"patch_radius", "m", VecX::Constant(1, c.radius)},
           {"max_patch_displacement", "m", VecX::Constant(1, max_du)},
           {"patch_displacement", "m", packed},
           {"patch_iterations", "", VecX::Constant(1, c.inner_iterations)},
