@@ -193,7 +193,9 @@ TEST_F(SceneCompileGolden, TeleopPinch) {
 
 // Two bodies meet skin against skin (skin_contact@0,1) with the bone
 // capsules as cores (body_contact@0,1): the states re-pinned when that became
-// the default body-body contact (an intended change of the physics).
+// the default body-body contact (an intended change of the physics), and
+// when a closest point on an edge of the box bodies came to take its side from
+// every face there (skin_contact.cpp, closest_skin_point), not one face's.
 TEST_F(SceneCompileGolden, TwoWalkers) {
   auto closer = [](SceneDescription& s) {
     s.bodies[0].offset.z() = -0.04;
@@ -202,7 +204,7 @@ TEST_F(SceneCompileGolden, TwoWalkers) {
   check({"two_walkers.yaml", closer, 6,
          {"inertia@0; elastic@0; gravity@0; bone_inertia@0; bone_gravity@0; joint_constraint@0; joint_limit@0; tracking@0; inertia@1; elastic@1; gravity@1; bone_inertia@1; bone_gravity@1; joint_constraint@1; joint_limit@1; tracking@1; skin_contact@0,1; body_contact@0,1",
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
-          "55315353cb598496", "01c8b1cc52dcdbf9", "14650fb0739d0383", 0}});
+          "55315353cb598496", "65475380961d7298", "14650fb0739d0383", 0}});
 }
 
 TEST_F(SceneCompileGolden, MomentumBump) {

@@ -67,8 +67,33 @@ TEST(SkinContact, TwoFlatFacesPressedTogetherGiveKappaDepthAreaByHand) {
     ASSERT_EQ(rep[0].name, "force");
     EXPECT_LT((Vec3(rep[0].value) - Vec3(-kappa * kFaceArea * d, 0, 0)).norm(), 1e-6 * kappa * kFaceArea * d)
         << Vec3(rep[0].value).transpose();
-    EXPECT_NEAR(rep[2].value[0], d, 1e-12);              // max penetration
+    EXPECT_NEAR(rep[2].value[0], d, 1e-12);              // max penetration (behind b's −x face, its nearest)
     EXPECT_NEAR(rep[3].value[0], kFaceArea, 1e-12);      // contact area (each side's, averaged)
+    ASSERT_EQ(rep[4].name, "max_plane_gap");
+    EXPECT_NEAR(rep[4].value[0], d, 1e-12);
+  }
+}
+
+TEST(SkinContact, ASampleThatSlidesOffTheOtherSkinWithinTheStepIsNotCountedAsPenetrating) {
+  // The pairs are made with b beside a, 1 mm of overlap. Over the step b
+  // moves 2 mm further in along −x and 13 cm up along +y: the lagged planes
+  // (b's −x face, moving with b) put a's +x face 3 mm behind them, but b is
+  // now above a (1 cm apart) and no sample is inside it, so the penetration is 0 while the
+  // plane gap is 3 mm. Moving only 2 mm in, without the slide, both are 3 mm.
+  const Avatar a = box(), b = box();
+  const SkinContactTerm term(a, b, {});
+  const Configuration qa = translated(a, Vec3::Zero());
+  for (double up : {0.13, 0.0}) {
+    std::vector<Bound> bodies = two_boxes(a, b, qa, translated(b, Vec3(0.079, 0, 0)), translated(b, Vec3(0.079, 0, 0)));
+    StepContext ctx = bind_bodies(bodies, nullptr);
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_TRUE(term.active(ctx));
+    bodies[1].q = translated(b, Vec3(0.077, up, 0));
+    const auto rep = term.report(ctx, qa);
+    ASSERT_EQ(rep[2].name, "max_penetration");
+    ASSERT_EQ(rep[4].name, "max_plane_gap");
+    EXPECT_NEAR(rep[4].value[0], 0.003, 1e-12) << "up " << up;
+    EXPECT_NEAR(rep[2].value[0], up > 0 ? 0.0 : 0.003, 1e-12) << "up " << up;
   }
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/geometry/aabb.hpp"
@@ -61,6 +62,54 @@ Vec3 face_normal(const Points& x, const Triangles& faces, int f) {
   const Vec3 n = (b - a).cross(c - a);
   const double len = n.norm();
   return len > 0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+/// The point of skin `to` (posed at x_to) closest to x among the faces around
+/// its vertex w and w's neighbours (where a smooth skin's closest point lies
+/// when w is x's nearest vertex), and the normal of a pair there: the face's
+/// where the point is inside it, else (an edge or a corner) the direction
+/// from it to x, signed by the side of the faces that share the point (the
+/// sum of their normals: one face's alone is ambiguous where x lies in its
+/// plane), so that normalᵀ(x − y) is the signed distance. `faces` is scratch.
+struct SkinPoint {
+  int face = -1;
+  Vec3 mu = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();
+  double distance = std::numeric_limits<double>::infinity();
+};
+SkinPoint closest_skin_point(const Vec3& x, const SkinContactTerm::Skin& to, const Points& x_to, int w,
+                             std::vector<int>& faces) {
+  faces.assign(to.vertex_faces[w].begin(), to.vertex_faces[w].end());
+  for (int u : to.vertex_neighbours[w]) faces.insert(faces.end(), to.vertex_faces[u].begin(), to.vertex_faces[u].end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  SkinPoint p;
+  for (int g : faces) {
+    const Vec3 mu = geometry::closest_point_on_triangle(x, x_to.row(to.faces(g, 0)).transpose(),
+                                                        x_to.row(to.faces(g, 1)).transpose(),
+                                                        x_to.row(to.faces(g, 2)).transpose());
+    const double d = (x - face_point(x_to, to.faces, g, mu)).norm();
+    if (d < p.distance) {
+      p.distance = d;
+      p.face = g;
+      p.mu = mu;
+    }
+  }
+  if (p.face < 0) return p;
+  const Vec3 offset = x - face_point(x_to, to.faces, p.face, p.mu);
+  p.normal = face_normal(x_to, to.faces, p.face);
+  if ((p.mu.array() <= 0).any() && p.distance > 1e-9) {
+    Vec3 side = Vec3::Zero();  // the faces at the closest point: those as close (to round-off)
+    const Vec3 y = x - offset;
+    for (int g : faces) {
+      const Vec3 mu = geometry::closest_point_on_triangle(y, x_to.row(to.faces(g, 0)).transpose(),
+                                                          x_to.row(to.faces(g, 1)).transpose(),
+                                                          x_to.row(to.faces(g, 2)).transpose());
+      if ((y - face_point(x_to, to.faces, g, mu)).norm() <= 1e-9 * (1.0 + p.distance)) side += face_normal(x_to, to.faces, g);
+    }
+    p.normal = (side.dot(offset) < 0 ? -1.0 : 1.0) * offset / p.distance;
+  }
+  return p;
 }
 
 }  // namespace
@@ -155,35 +204,18 @@ void SkinContactTerm::collect_pairs(int side, const Skin& from, const Points& x_
       const int w_near = grid.nearest(x, nearest + from.max_edge);
       if (w_near < 0) continue;
       const int w = to_index[w_near];
-      faces_near.assign(to.vertex_faces[w].begin(), to.vertex_faces[w].end());
-      for (int u : to.vertex_neighbours[w]) faces_near.insert(faces_near.end(), to.vertex_faces[u].begin(), to.vertex_faces[u].end());
-      std::sort(faces_near.begin(), faces_near.end());
-      faces_near.erase(std::unique(faces_near.begin(), faces_near.end()), faces_near.end());
-      double best = std::numeric_limits<double>::infinity();
+      const SkinPoint closest = closest_skin_point(x, to, x_to, w, faces_near);
+      if (closest.face < 0) continue;
       Pair p;
-      for (int g : faces_near) {
-        const Vec3 mu = geometry::closest_point_on_triangle(
-            x, x_to.row(to.faces(g, 0)).transpose(), x_to.row(to.faces(g, 1)).transpose(),
-            x_to.row(to.faces(g, 2)).transpose());
-        const double d = (x - face_point(x_to, to.faces, g, mu)).norm();
-        if (d < best) {
-          best = d;
-          p.other_face = g;
-          p.mu = mu;
-        }
-      }
-      if (!(best < std::numeric_limits<double>::infinity())) continue;
+      p.other_face = closest.face;
+      p.mu = closest.mu;
+      p.normal = closest.normal;
       double m_other = 0;
       for (int c = 0; c < 3; ++c) m_other = std::max(m_other, m_to[to.faces(p.other_face, c)]);
-      // The normal: the face's where the closest point is inside it, else
-      // (an edge or a corner) the direction from it to the sample, signed by
-      // the face's side, so that the gap is the signed distance at time t and
-      // the pair's forces are collinear there. Surfaces that face the same
-      // way (coplanar neighbours, a sample on the far side) do not touch.
+      // Surfaces that face the same way (coplanar neighbours, a sample on the
+      // far side) do not touch.
       const Vec3 face_n = face_normal(x_to, to.faces, p.other_face);
       const Vec3 offset = x - face_point(x_to, to.faces, p.other_face, p.mu);
-      p.normal = face_n;
-      if ((p.mu.array() <= 0).any() && best > 1e-9) p.normal = (face_n.dot(offset) < 0 ? -1.0 : 1.0) * offset / best;
       if (face_normal(x_from, from.faces, f).dot(face_n) > 0) continue;
       const double gap = p.normal.dot(offset);
       if (gap > options_.margin + kMotionFactor * (m_sample + m_other) || gap < -options_.max_depth) continue;
@@ -294,8 +326,9 @@ std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const 
   const double half_kappa = 0.5 * options_.pressure_stiffness;
   Vec3 force = Vec3::Zero();
   int active = 0;
-  double worst = 0, area = 0, weight = 0;
+  double worst_plane = 0, area = 0, weight = 0;
   Vec3 point = Vec3::Zero();
+  std::vector<std::pair<int, Vec3>> touching;  // (side, sample point) of the pairs with g < 0
   for (const Pair& p : c.pairs) {
     const int from = p.side;
     const double g = gap(p, c, x);
@@ -304,17 +337,39 @@ std::vector<TermQuantity> SkinContactTerm::report(const StepContext& ctx, const 
     const Vec3 on_sample = -half_kappa * p.area * g * p.normal;
     force += from == 0 ? on_sample : Vec3(-on_sample);
     ++active;
-    worst = std::max(worst, -g);
+    worst_plane = std::max(worst_plane, -g);
     area += 0.5 * p.area;
     Vec3 sample = Vec3::Zero();
     for (int i = 0; i < 3; ++i) sample += p.lambda[i] * x[from].row(c.slot[from][skins_[from].faces(p.face, i)]).transpose();
     point += on_sample.norm() * sample;
     weight += on_sample.norm();
+    touching.emplace_back(from, sample);
+  }
+  // The penetration: each touching sample's depth behind the other skin at q,
+  // its closest point found afresh. The penalty's gap is measured to the
+  // plane of the closest point at time t (header comment), which a sample
+  // that slides over a curved part within the step (a swinging foot) can be
+  // far behind while it is outside the skin: that gap is reported apart.
+  double worst = 0;
+  std::array<Points, 2> skin_at_q;
+  std::array<std::unique_ptr<geometry::PointGrid>, 2> grid;
+  std::vector<int> scratch;
+  for (const auto& [from, sample] : touching) {
+    const int to = 1 - from;
+    if (!grid[to]) {
+      skin_at_q[to] = skins_[to].vertices.world(*qs[to]);
+      grid[to] = std::make_unique<geometry::PointGrid>(skin_at_q[to], 0.02);
+    }
+    const int w = grid[to]->nearest(sample, options_.max_depth + skins_[to].max_edge);
+    if (w < 0) continue;  // no skin within reach: not behind it
+    const SkinPoint y = closest_skin_point(sample, skins_[to], skin_at_q[to], w, scratch);
+    if (y.face >= 0) worst = std::max(worst, -y.normal.dot(sample - face_point(skin_at_q[to], skins_[to].faces, y.face, y.mu)));
   }
   std::vector<TermQuantity> out = {{"force", "N", force},
                                    {"active_samples", "", VecX::Constant(1, active)},
                                    {"max_penetration", "m", VecX::Constant(1, worst)},
-                                   {"contact_area", "m^2", VecX::Constant(1, area)}};
+                                   {"contact_area", "m^2", VecX::Constant(1, area)},
+                                   {"max_plane_gap", "m", VecX::Constant(1, worst_plane)}};
   // Where the pressure acts: the samples' mean, weighted by their force (only while in contact).
   if (weight > 0) out.push_back({"contact_point", "m", point / weight});
   return out;
