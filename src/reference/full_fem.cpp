@@ -197,7 +197,7 @@ double FullFem::evaluate(const Points& u, VecX* grad, bool hessian) {
         }
     }
   }
-  return E + evaluate_contact(u, grad, hessian, nullptr);
+  return E + evaluate_contact(u, grad, hessian, nullptr) + evaluate_anchors(u, grad, hessian, nullptr);
 }
 
 FullFemReport FullFem::step(const std::vector<Isometry>& bones_next, const std::vector<Isometry>& obstacle_poses) {
@@ -208,6 +208,8 @@ FullFemReport FullFem::step(const std::vector<Isometry>& bones_next, const std::
   FullFemReport rep;
   const Avatar& a = *avatar_;
   x_pred_ = 2.0 * x_now_ - x_prev_;
+  anchor_start_.clear();  // at t: the bones and u before the step
+  for (const FullFemAnchor& p : anchors_) anchor_start_.push_back(skin_point(p.vertex, u_));
   bones_ = bones_next;
   obstacle_poses_ = obstacle_poses;
   ms_contact_ = 0;
@@ -275,6 +277,7 @@ FullFemReport FullFem::step(const std::vector<Isometry>& bones_next, const std::
     }
   }
   evaluate_contact(u_, nullptr, false, &rep.contacts);
+  evaluate_anchors(u_, nullptr, false, &rep.anchor_force);
   rep.ms_contact = ms_contact_;
   x_prev_ = x_now_;
   x_now_ = world_nodes(u_, bones_);

@@ -1,4 +1,4 @@
-// Rigid obstacles in the full-FEM reference (samples on the skin's faces,
+// Rigid obstacles and anchors in the full-FEM reference (samples on the skin's faces,
 // pressure stiffness κ): the contact energy, gradient and Gauss–Newton Hessian
 // against an independent closed-form sphere penalty over the face samples and
 // finite differences (skin vertices embedded with mixed barycentric
@@ -13,6 +13,7 @@
 #include <random>
 #include <set>
 
+#include "sflsh/core/error.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
@@ -181,6 +182,104 @@ TEST(FullFemContact, AFreeBoxOnTheFloorIsHeldByItsWeight) {
   // (and far less than a millimetre).
   EXPECT_GT(c.max_penetration, weight / (kappa * 0.08 * 0.08));
   EXPECT_LT(c.max_penetration, 1e-3);
+}
+
+// Anchors (FullFemAnchor): skin points tied to moving tool points by
+// spring–dampers. The energy against anchor.hpp's closed form over the
+// asset's skin points (posed bones, mixed barycentric embedding), its
+// gradient against finite differences of that closed form and its Hessian
+// against (k + c/h) JᵀJ with J by finite differences; the reported force; and
+// bad anchors refused naming the anchor.
+TEST(FullFemContact, AnchorEnergyGradientHessianAndForce) {
+  test::SyntheticAvatarOptions so;
+  so.handles = 0;
+  const auto a = std::make_shared<const Avatar>(with_embedded_skin(test::make_synthetic_avatar(so)));
+  FullFemOptions o;
+  o.gravity = Vec3::Zero();
+  FullFem with(a, o), without(a, o);
+  const auto bones = test::synthetic_motion(*a, 0.1, 0.03, 0.1);
+  const Points zero = Points::Zero(a->tet.num_nodes(), 3);
+  // Two anchors on distinct skin vertices, tool points a few mm off and moving.
+  const int v0 = 3, v1 = int(a->surface_rest.rows()) - 5;
+  const std::vector<FullFemAnchor> anchors = {
+      {v0, skin_world(*a, v0, zero, bones) + Vec3(0.004, -0.002, 0.001), skin_world(*a, v0, zero, identity_bones()) +
+                                                                              Vec3(0.001, 0, 0), 2.0e4, 3.0},
+      {v1, skin_world(*a, v1, zero, bones) + Vec3(-0.001, 0.003, 0.002), skin_world(*a, v1, zero, identity_bones()),
+       5.0e3, 0.0}};
+  with.set_anchors(anchors);
+  EXPECT_EQ(with.num_anchors(), 2);
+  with.step(bones);
+  without.step(bones);
+  const Points u1 = with.displacement();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1e-3, 1e-3);
+  Points u = zero;
+  std::vector<int> free_of(a->tet.num_nodes(), -1);
+  int nfree = 0;
+  for (int n = 0; n < a->tet.num_nodes(); ++n)
+    if (a->node_role[n] == int(NodeRole::Simulated)) {
+      free_of[n] = nfree++;
+      for (int i = 0; i < 3; ++i) u(n, i) = U(rng);
+    }
+  const double h = o.h;
+  // Closed form: x_t is the vertex at the rest state and identity bones (the step's start).
+  auto anchor_energy = [&](const Points& uu) {
+    double E = 0;
+    for (const FullFemAnchor& p : anchors) {
+      const Vec3 x = skin_world(*a, p.vertex, uu, bones), xt = skin_world(*a, p.vertex, zero, identity_bones());
+      E += 0.5 * p.hardness * (x - p.target).squaredNorm() +
+           0.5 * p.damping / h * ((x - xt) - (p.target - p.target_prev)).squaredNorm();
+    }
+    return E;
+  };
+  VecX g1, g0;
+  Eigen::SparseMatrix<double> H1, H0;
+  const double E = with.energy(u, &g1, &H1) - without.energy(u, &g0, &H0);
+  const double Ec = anchor_energy(u);
+  ASSERT_GT(Ec, 0);
+  EXPECT_NEAR(E, Ec, 1e-9 * Ec);
+  VecX fd(3 * nfree);
+  MatX J = MatX::Zero(6, 3 * nfree);  // the two anchors' points over the free DoFs
+  const double eps = 1e-7;
+  for (int n = 0; n < u.rows(); ++n)
+    for (int i = 0; i < 3 && free_of[n] >= 0; ++i) {
+      Points up = u, um = u;
+      up(n, i) += eps;
+      um(n, i) -= eps;
+      fd[3 * free_of[n] + i] = (anchor_energy(up) - anchor_energy(um)) / (2 * eps);
+      for (int k = 0; k < 2; ++k)
+        J.block<3, 1>(3 * k, 3 * free_of[n] + i) =
+            (skin_world(*a, anchors[size_t(k)].vertex, up, bones) - skin_world(*a, anchors[size_t(k)].vertex, um, bones)) /
+            (2 * eps);
+    }
+  EXPECT_LT((g1 - g0 - fd).norm(), 1e-6 * fd.norm());
+  MatX Hc = MatX::Zero(3 * nfree, 3 * nfree);
+  for (int k = 0; k < 2; ++k)
+    Hc += (anchors[size_t(k)].hardness + anchors[size_t(k)].damping / h) * J.middleRows<3>(3 * k).transpose() *
+          J.middleRows<3>(3 * k);
+  EXPECT_LT((MatX(H1) - MatX(H0) - Hc).norm(), 1e-6 * Hc.norm());
+  // The force on the body at a second step's end: −Σ ∂E/∂x_v at its final u,
+  // x_t now where the first step left the vertex (the targets given again).
+  const FullFemReport rep = with.step(bones);
+  Vec3 f = Vec3::Zero();
+  for (const FullFemAnchor& p : anchors) {
+    const Vec3 x = skin_world(*a, p.vertex, with.displacement(), bones), xt = skin_world(*a, p.vertex, u1, bones);
+    f -= p.hardness * (x - p.target) + p.damping / h * ((x - xt) - (p.target - p.target_prev));
+  }
+  ASSERT_GT(f.norm(), 1.0);
+  EXPECT_LT((rep.anchor_force - f).norm(), 1e-9 * f.norm()) << rep.anchor_force.transpose() << " vs " << f.transpose();
+  for (const auto& [anchor, words] : std::vector<std::pair<FullFemAnchor, std::vector<std::string>>>{
+           {{-1, Vec3::Zero(), Vec3::Zero(), 1e3, 1.0}, {"anchor 0", "skin vertex -1"}},
+           {{0, Vec3(NAN, 0, 0), Vec3::Zero(), 1e3, 1.0}, {"anchor 0", "target"}},
+           {{0, Vec3::Zero(), Vec3::Zero(), 0.0, 1.0}, {"anchor 0", "hardness"}},
+           {{0, Vec3::Zero(), Vec3::Zero(), 1e3, -1.0}, {"anchor 0", "damping"}}}) {
+    try {
+      with.set_anchors({anchor});
+      ADD_FAILURE() << "accepted a bad anchor";
+    } catch (const Error& e) {
+      for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
+    }
+  }
 }
 
 // The reduced model's face-sampled contact (contact_patch.hpp, without its

@@ -76,6 +76,17 @@ struct FullFemObstacle {
   double spacing = kDefaultContactSpacing;  ///< m, sample spacing on the skin's faces (skin_face_samples.hpp)
 };
 
+/// A skin point tied to a tool point over one step (sim/energies/anchor.hpp's
+/// energy): E = ½ k |x_v − a|² + ½ (c/h) |(x_v − x_v,t) − (a − a_t)|², x_v the
+/// skin vertex (embedded in its tet and skinned, as the contact samples' points).
+struct FullFemAnchor {
+  int vertex = 0;                   ///< skin vertex (row of Avatar::surface_rest)
+  Vec3 target = Vec3::Zero();       ///< a, m, world: the tool point at t + h
+  Vec3 target_prev = Vec3::Zero();  ///< a_t, m, world: the tool point at t
+  double hardness = 1.0e3;          ///< k, N/m (> 0)
+  double damping = 1.0;             ///< c, N·s/m (>= 0)
+};
+
 /// One obstacle's contact at the end of a step.
 struct FullFemContact {
   std::string name;
@@ -94,6 +105,9 @@ struct FullFemReport {
   double ms_total = 0, ms_factorize = 0;
   double ms_contact = 0;       ///< time evaluating the obstacles' penalties (all evaluations)
   std::vector<FullFemContact> contacts;  ///< per obstacle, in add_obstacle order, at the final u
+  /// N, world: what the anchors (set_anchors) exert on the body at the final
+  /// u, Σ −∂E/∂x_v; the tool feels the opposite.
+  Vec3 anchor_force = Vec3::Zero();
 };
 
 class FullFem {
@@ -112,6 +126,11 @@ class FullFem {
   /// line naming the obstacle for a null field, κ or spacing not finite and > 0.
   int add_obstacle(FullFemObstacle obstacle);
   int num_obstacles() const { return int(obstacles_.size()); }
+  /// The anchors of the next steps (FullFemAnchor; none by default), until
+  /// set again. Throws one line naming the anchor for a vertex out of range, a
+  /// target not finite, k not finite and > 0 or c not finite and >= 0.
+  void set_anchors(std::vector<FullFemAnchor> anchors);
+  int num_anchors() const { return int(anchors_.size()); }
   /// One backward-Euler step to t + h with the bones prescribed at `bones_next`
   /// and each obstacle's field placed at `obstacle_poses[i]` (local → world at
   /// t + h; one per add_obstacle, may be empty without obstacles).
@@ -142,6 +161,9 @@ class FullFem {
   Points world_nodes(const Points& u, const std::vector<Isometry>& bones) const;
   double evaluate(const Points& u, VecX* grad, bool hessian);
   double evaluate_contact(const Points& u, VecX* grad, bool hessian, std::vector<FullFemContact>* report) const;
+  /// The anchors' energy; gradient, Gauss–Newton Hessian (exact: x_v is affine
+  /// in u) and the force on the body when asked.
+  double evaluate_anchors(const Points& u, VecX* grad, bool hessian, Vec3* force) const;
   Vec3 skin_point(int v, const Points& u) const;
   /// Lower-CSC pattern of the Hessian (elastic + inertia; with the skin faces'
   /// node couplings when `couple_skin_faces`) and the tet / node slot tables.
@@ -183,6 +205,9 @@ class FullFem {
   mutable std::unordered_map<int, FaceNodes> face_nodes_;  // per candidate face, made on first use
   mutable std::vector<std::unordered_map<int, std::vector<SkinFaceSample>>> face_samples_;  // per obstacle, per face
   mutable double ms_contact_ = 0;
+  // Anchors.
+  std::vector<FullFemAnchor> anchors_;
+  std::vector<Vec3> anchor_start_;  // x_v,t per anchor (world, at the step's start)
 };
 
 }  // namespace sflsh

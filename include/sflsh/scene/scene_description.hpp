@@ -34,12 +34,26 @@
 //   contact:
 //     stiffness:                # penalty ½k·d² per contact sample (N/m, >= 0)
 //       body_object: 2.0e5      # skin samples against rigid objects; default 2e5
-//                               # (an avatar dropped 0.4 m onto the floor: 4.2 mm deepest)
+//                               # (an avatar dropped 0.4 m onto the floor: 8.9 mm deepest)
 //       body_body: 1.0e6        # bone capsules of different bodies; default 1e6
 //       self: 1.0e5             # non-adjacent capsules of one body; default 1e5
 //     friction: 0.5             # Coulomb μ between skin and rigid objects (>= 0); default 0.5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
+//     patch:                    # contact that dents (static and kinematic objects, tools; needs
+//                               # friction: 0): a pressure over the skin's faces and a full-space
+//                               # patch under it (sim/energies/contact_patch.hpp); `patch: true`
+//                               # takes the defaults; default off
+//       radius: 0.04            # m: nodes within it of the near skin; grows to 1.5 contact radii
+//       max_nodes: 120          # nodes in one patch at most (>= 1)
+//       pressure_stiffness: 1.0e8   # N/m³ (> 0)
+//       spacing: 0.002          # m between face samples (> 0)
+//     bodies:                   # body-body contact
+//       model: skin             # skin (the skins press, the flesh gives; capsule cores behind)
+//                               # or capsules (rigid bone capsules alone); default skin
+//       pressure_stiffness: 1.0e8   # N/m³ (> 0)
+//       spacing: 0.01           # m between face samples (> 0)
+//       core_radius: 0.5        # share of each capsule's radius kept as a core, (0, 1]
 //     pairs: all                # default all: every body-object and body-body pair;
 //                               # or a list of name pairs: [[alice, floor], [alice, bob]]
 //   bodies:                     # required, at least one
