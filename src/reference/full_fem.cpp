@@ -277,7 +277,8 @@ FullFemReport FullFem::step(const std::vector<Isometry>& bones_next, const std::
     }
   }
   evaluate_contact(u_, nullptr, false, &rep.contacts);
-  evaluate_anchors(u_, nullptr, false, &rep.anchor_force);
+  evaluate_anchors(u_, nullptr, false, &rep.anchor_forces);
+  for (const Vec3& f : rep.anchor_forces) rep.anchor_force += f;
   rep.ms_contact = ms_contact_;
   x_prev_ = x_now_;
   x_now_ = world_nodes(u_, bones_);

@@ -22,8 +22,8 @@ void FullFem::set_anchors(std::vector<FullFemAnchor> anchors) {
   anchors_ = std::move(anchors);
 }
 
-double FullFem::evaluate_anchors(const Points& u, VecX* grad, bool hessian, Vec3* force) const {
-  if (force) force->setZero();
+double FullFem::evaluate_anchors(const Points& u, VecX* grad, bool hessian, std::vector<Vec3>* forces) const {
+  if (forces) forces->clear();
   if (anchors_.empty()) return 0;
   require(anchor_start_.size() == anchors_.size(), "FullFem: anchors set after the step started");
   const Avatar& a = *avatar_;
@@ -37,7 +37,7 @@ double FullFem::evaluate_anchors(const Points& u, VecX* grad, bool hessian, Vec3
     const Vec3 slip = (x - anchor_start_[i]) - (p.target - p.target_prev);
     E += 0.5 * p.hardness * stretch.squaredNorm() + 0.5 * p.damping * c_h * slip.squaredNorm();
     const Vec3 fx = p.hardness * stretch + p.damping * c_h * slip;  // ∂E/∂x
-    if (force) *force -= fx;
+    if (forces) forces->push_back(-fx);
     if (!grad && !hessian) continue;
     // ∂x/∂u_{n_c} = b_c A_v over the nodes of the vertex's tet.
     const int t = a.surface_tet[p.vertex];

@@ -9,6 +9,7 @@
 #include "sflsh/scene/rigid_object.hpp"
 #include "sflsh/scene/scene_session.hpp"
 #include "sflsh/reference/full_fem.hpp"
+#include "sflsh/sim/grasp_controller.hpp"
 
 namespace sflsh {
 namespace {
@@ -38,8 +39,7 @@ void check_scene_reference(const SceneDescription& sc) {
   for (const ToolDescription& t : sc.tools) {
     require(!t.coupled, where, ": tools '", t.name, "' has a coupling; --solver full takes kinematic tools only");
     require(t.stream_port < 0, where, ": tools '", t.name, "' reads a live stream; --solver full runs offline");
-    require(t.jaws.empty() && t.sensors.empty(), where, ": tools '", t.name,
-            "' has jaws or a grasp; --solver full has no anchors");
+    require(t.jaws.empty(), where, ": tools '", t.name, "' has jaws; --solver full has no jaw contact");
   }
 }
 
@@ -61,6 +61,14 @@ SceneDescription reference_scene(const SceneDescription& sc) {
               << out.contact.friction << " is dropped)\n";
   return out;
 }
+
+/// A kinematic tool with a grasp, on the reference's skin (header comment).
+struct ReferenceGrasp {
+  int tool = 0;
+  GraspController grasp;
+  double hardness = 0, damping = 0;
+  size_t first = 0, count = 0;  // its anchors in the step's FullFemAnchor list
+};
 
 }  // namespace
 
@@ -101,6 +109,15 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   for (const ToolDescription& t : sc.tools)
     if (t.has_shape) add(t.name, t.shape, ObjectKind::Kinematic);
 
+  std::vector<ReferenceGrasp> grasps;
+  for (int i = 0; i < session.num_tools(); ++i) {
+    const CompiledTool& tool = session.compiled_tool(i);
+    if (!tool.desc->sensors.empty())
+      grasps.push_back({i, GraspController(tool.grasp), tool.desc->hardness, tool.desc->damping});
+  }
+  std::vector<ToolEvent> tool_events;
+  std::vector<Vec3> tool_forces(size_t(session.num_tools()), Vec3::Zero());
+
   SceneContactStats st;
   for (int i = 0; i < fem.num_obstacles(); ++i)
     st.pairs.push_back({"contact:" + r.objects[size_t(obstacle_object[size_t(i)])].name, body_name});
@@ -115,8 +132,12 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   auto record = [&](double ms) {
     FrameData fr = session.frame(ms);
     fr.contacts = contacts;
+    for (size_t i = 0; i < fr.tools.size() && i < tool_forces.size(); ++i) {
+      fr.tools[i].force = tool_forces[i];
+      fr.tools[i].torque.setZero();  // the reference reports the anchors' force only
+    }
     r.add_frame(std::move(fr));
-    r.tool_events = session.tool_events();
+    r.tool_events = tool_events;
     ++r.num_frames;
     r.frame_positions.back() = fem.posed_surface();
     r.frame_displacement.back() = fem.soft_displacement();
@@ -130,7 +151,36 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   Progress progress("full-FEM reference of " + r.motion, steps);
   for (long k = 0; k < steps; ++k) {
     if (interrupt_signal()) throw_if_interrupted("at step " + std::to_string(k + 1) + " of " + std::to_string(steps));
+    // The grasping tools' devices at t (before the session's step) and t + h.
+    std::vector<teleop::PoseSample> before;
+    for (const ReferenceGrasp& g : grasps) before.push_back(session.tool_state(g.tool).device);
     session.advance();
+    if (!grasps.empty()) {
+      const double h = session.dt(), t0 = double(k) * h;
+      std::vector<FullFemAnchor> anchors;
+      Points skin;  // the reference's skin at t, while a tool looks for something to grasp
+      std::vector<AnchorPoint> points;
+      for (size_t g = 0; g < grasps.size(); ++g) {
+        ReferenceGrasp& rg = grasps[g];
+        const teleop::PoseSample& now = before[g];
+        const teleop::PoseSample& next = session.tool_state(rg.tool).device;
+        const Isometry pose_now = pose_at(now.position, now.orientation);
+        if (rg.grasp.seeking(now.closure) && skin.size() == 0) skin = fem.skin_points(fem.displacement());
+        if (rg.grasp.update(t0, pose_now, now.closure, rg.grasp.seeking(now.closure) ? skin : Points(),
+                            sim.model().bodies()[size_t(body)].avatar->surface_faces)) {
+          const GraspEvent& ev = rg.grasp.log().back();
+          tool_events.push_back({ev.time, session.tool_name(rg.tool), body_name,
+                                 ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
+        }
+        anchor_points(frame_between(pose_now, pose_at(next.position, next.orientation), h), rg.grasp.anchors(), false,
+                      points);
+        rg.first = anchors.size();
+        rg.count = points.size();
+        for (const AnchorPoint& p : points)
+          anchors.push_back({p.point, p.position, p.position - h * p.velocity, rg.hardness, rg.damping});
+      }
+      fem.set_anchors(std::move(anchors));
+    }
     const std::vector<Isometry> all = session.object_poses();
     std::vector<Isometry> poses;
     for (int i : obstacle_object) poses.push_back(all.at(size_t(i)));
@@ -139,6 +189,11 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     const double cpu_ms = thread_cpu_ms() - cpu0;
     const double t = (k + 1) * session.dt();
     if (!rep.converged) ++not_converged;
+    for (const ReferenceGrasp& g : grasps) {
+      Vec3 f = Vec3::Zero();  // on the tool: the anchors' reaction
+      for (size_t i = g.first; i < g.first + g.count; ++i) f -= rep.anchor_forces.at(i);
+      tool_forces[size_t(g.tool)] = f;
+    }
     for (size_t i = 0; i < rep.contacts.size(); ++i) {
       SceneContactStats::Pair& p = st.pairs[i];
       const FullFemContact& c = rep.contacts[i];
@@ -165,7 +220,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
       ms_since_frame = 0;
       steps_since_frame = 0;
     }
-    if (opt.on_step) opt.on_step({k + 1, t, &fem, &rep, &poses, cpu_ms});
+    if (opt.on_step) opt.on_step({k + 1, t, &fem, &rep, &poses, &tool_forces, cpu_ms});
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();

@@ -6,6 +6,7 @@
 
 #include "scene/box_avatar_fixture.hpp"
 #include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_session.hpp"
 #include "test_support.hpp"
 
 using namespace sflsh;
@@ -100,6 +101,75 @@ TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject)
   EXPECT_GT(a.pairs.at(0).max_force, 0.05);
 }
 
+// A kinematic tool with a grasp sensor above the top closes at 0.05 s, lifts
+// 3 mm by 0.15 s, holds, and opens at 0.25 s. The reference grasps its own
+// skin by the reduced run's rule: the same events at the same times (the
+// same points: the sensor hits the same face), the anchored skin rises with
+// the tool, the body pulls the tool down while it holds (the same direction
+// and scale as the reduced run's force on the box's 6-handle basis), and
+// nothing after the release.
+TEST_F(SceneReference, AToolGraspsTheReferencesSkinLiftsItAndLetsGo) {
+  const std::string text = R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
+output: {fps: 20}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.002, 0.04, 0.001], closure: 0.8}
+      - {time: 0.05, position: [0.002, 0.04, 0.001], closure: 0.0}
+      - {time: 0.15, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.24, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.25, position: [0.002, 0.043, 0.001], closure: 0.8}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
+      hardness: 2.0e3
+      damping: 1.0
+)";
+  const SceneDescription sc = read_scene_description(write_scene(text));
+  std::vector<Vec3> force_full;
+  SceneReferenceOptions o = quiet();
+  o.on_step = [&](const SceneReferenceStep& s) {
+    ASSERT_EQ(s.tool_forces->size(), 1u);
+    force_full.push_back(s.tool_forces->at(0));
+  };
+  const SimulationResult full = run_scene_reference(sc, o);
+  std::vector<Vec3> force_reduced;
+  SceneSessionOptions so;
+  so.progress = false;
+  SceneSession reduced(sc, so);
+  while (reduced.steps_done() < reduced.total_steps()) {
+    reduced.advance();
+    force_reduced.push_back(reduced.tool_state(0).force);
+  }
+  ASSERT_EQ(force_full.size(), 30u);
+  ASSERT_EQ(force_reduced.size(), 30u);
+  const std::vector<ToolEvent>& ev = reduced.tool_events();
+  ASSERT_EQ(full.tool_events.size(), 2u);
+  ASSERT_EQ(ev.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(full.tool_events[i].kind, i == 0 ? "grasp" : "release");
+    EXPECT_EQ(full.tool_events[i].kind, ev[i].kind);
+    EXPECT_NEAR(full.tool_events[i].time, ev[i].time, 1e-12);
+    EXPECT_EQ(full.tool_events[i].points, ev[i].points);
+    EXPECT_GT(full.tool_events[i].points, 0);
+  }
+  // Held and lifted (t = 0.2 s, step 20): the body pulls the tool down, as in the reduced run.
+  const Vec3 f = force_full[19], fr = force_reduced[19];
+  EXPECT_LT(f.y(), -0.2) << f.transpose();
+  EXPECT_LT(std::hypot(f.x(), f.z()), 0.2 * -f.y()) << f.transpose();
+  EXPECT_GT(f.y() / fr.y(), 0.3) << f.transpose() << " vs reduced " << fr.transpose();
+  EXPECT_LT(f.y() / fr.y(), 1.5) << f.transpose() << " vs reduced " << fr.transpose();
+  // The result's tool frames carry the reference's force; after the release, none.
+  ASSERT_EQ(full.tools.size(), 1u);
+  EXPECT_EQ(full.tools[0].frames[4].force, force_full[19]);  // frame 4: t = 0.2 s
+  EXPECT_EQ(force_full.back(), Vec3::Zero());
+  // The skin under the tool rose with it (the top is at y = 0.03).
+  double highest = 0;
+  for (int v = 0; v < full.frame_positions[4].rows(); ++v) highest = std::max(highest, full.frame_positions[4](v, 1));
+  EXPECT_GT(highest, 0.0315);
+}
+
 TEST_F(SceneReference, ScenesItCannotRunAreRefusedNamingTheItem) {
   const std::string head = "solver: {dt: 1/100, seconds: 0.1}\nbodies:\n  - {name: base, avatar: box.h5}\n";
   auto refused = [&](const std::string& text, std::initializer_list<std::string> fragments) {
@@ -113,4 +183,8 @@ TEST_F(SceneReference, ScenesItCannotRunAreRefusedNamingTheItem) {
   refused(head + "tools:\n  - name: probe\n    shape: {type: sphere, radius: 0.005}\n"
                  "    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    coupling: {stiffness: 2000}\n",
           {"scene.yaml", "tools 'probe'", "coupling"});
+  refused(head + "tools:\n  - name: pincer\n    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    gripper:\n"
+                 "      hinge: {origin: [0, 0.03, 0], axis: [1, 0, 0]}\n      jaws:\n"
+                 "        - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, 0.004], side: 1}\n",
+          {"scene.yaml", "tools 'pincer'", "jaws"});
 }

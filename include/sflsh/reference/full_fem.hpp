@@ -105,8 +105,9 @@ struct FullFemReport {
   double ms_total = 0, ms_factorize = 0;
   double ms_contact = 0;       ///< time evaluating the obstacles' penalties (all evaluations)
   std::vector<FullFemContact> contacts;  ///< per obstacle, in add_obstacle order, at the final u
-  /// N, world: what the anchors (set_anchors) exert on the body at the final
-  /// u, Σ −∂E/∂x_v; the tool feels the opposite.
+  /// N, world: what each anchor (set_anchors, in order) exerts on the body at
+  /// the final u, −∂E/∂x_v; the tool feels the opposite. anchor_force: their sum.
+  std::vector<Vec3> anchor_forces;
   Vec3 anchor_force = Vec3::Zero();
 };
 
@@ -161,9 +162,9 @@ class FullFem {
   Points world_nodes(const Points& u, const std::vector<Isometry>& bones) const;
   double evaluate(const Points& u, VecX* grad, bool hessian);
   double evaluate_contact(const Points& u, VecX* grad, bool hessian, std::vector<FullFemContact>* report) const;
-  /// The anchors' energy; gradient, Gauss–Newton Hessian (exact: x_v is affine
-  /// in u) and the force on the body when asked.
-  double evaluate_anchors(const Points& u, VecX* grad, bool hessian, Vec3* force) const;
+  /// The anchors' energy; gradient, Hessian (exact: x_v is affine in u) and
+  /// each anchor's force on the body when asked.
+  double evaluate_anchors(const Points& u, VecX* grad, bool hessian, std::vector<Vec3>* forces) const;
   Vec3 skin_point(int v, const Points& u) const;
   /// Lower-CSC pattern of the Hessian (elastic + inertia; with the skin faces'
   /// node couplings when `couple_skin_faces`) and the tet / node slot tables.

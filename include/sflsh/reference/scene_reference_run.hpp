@@ -9,9 +9,13 @@
 // frictionless obstacles whose contact is a pressure over the skin's faces
 // (contact.pressure_stiffness, contact.spacing: the same keys as the reduced
 // solver's contact patch). The poses of bones, objects and tools come from the
-// scene session, so both solvers see the same inputs.
+// scene session, so both solvers see the same inputs. A kinematic tool with a
+// grasp grasps the reference's own skin by the reduced run's rule
+// (grasp_controller.hpp: the same sensors, closure threshold and tool path;
+// anchors start unstretched on the reference's skin) and holds it with the
+// same spring–dampers (FullFemAnchor); its force is the anchors' reaction.
 // Refused (one line naming the scene and the item): several bodies, dynamic
-// objects, tools with a coupling, a live stream, jaws or a grasp. Dynamic bones
+// objects, tools with a coupling, a live stream or jaws. Dynamic bones
 // run kinematic and friction is dropped, each with a warning line on stderr.
 // Cost: seconds per step on the default body (a sparse Cholesky of ~30k DoFs
 // per Newton iteration); progress is shown.
@@ -32,6 +36,9 @@ struct SceneReferenceStep {
   const FullFem* fem = nullptr;                     ///< the reference (posed_surface(), soft_displacement())
   const FullFemReport* report = nullptr;            ///< contacts: one per obstacle, in the stats' pair order
   const std::vector<Isometry>* obstacle_poses = nullptr;  ///< world, one per obstacle
+  /// N, world, one per tool of the scene: what the body exerts on it through
+  /// its anchors (zero for a tool that does not grasp).
+  const std::vector<Vec3>* tool_forces = nullptr;
   double cpu_ms = 0;                                ///< thread CPU time of the reference's step
 };
 
