@@ -187,7 +187,7 @@ const CommandRegistrar reg(51, [](CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--scene", a->scene_files,
                   "A scene file (YAML, as `sflsh simulate`) to run with the reduced solver as written and with the "
-                  "full-FEM reference, compared per contact pair (repeatable). Alone it replaces the built-in scenes; "
+                  "full-FEM reference, compared per contact pair and grasping tool (repeatable). Alone it replaces the built-in scenes; "
                   "with --scenes both run. The scene sets its own avatar, solver and contact: the built-in scenes' "
                   "flags (--handles, --quick, --pressure-stiffness, ...) are refused with --scene alone. Writes "
                   "contact_<name>.csv/.svg per scene, contact_scenes.csv and a section of contact_bench.md");

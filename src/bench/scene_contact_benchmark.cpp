@@ -8,6 +8,7 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/core/timer.hpp"
+#include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/reference/full_fem.hpp"
 #include "sflsh/reference/scene_reference_run.hpp"
 #include "sflsh/scene/rigid_object.hpp"
@@ -25,11 +26,14 @@ const std::string& scene_name(const SceneDescription& sc) {
 }
 
 /// An object or tool with a shape that touches the body: what the reference
-/// makes an obstacle of, in its order (objects, then tools).
+/// makes an obstacle of, in its order (objects, then tools); then the tools
+/// without a shape that grasp (compared by the force on the tool, their
+/// "dent" the skin's largest |u| near the tool's origin).
 struct Partner {
   std::string name;
-  geometry::SdfPtr field;  // shape frame
+  geometry::SdfPtr field;  // shape frame (a grasping tool: a 1 mm ball at its origin)
   bool kinematic = false;
+  int grasp_tool = -1;     // a grasping tool: its index in the scene's tools
 };
 
 /// Whether the body and `name` collide as the reference takes it: every pair,
@@ -55,6 +59,9 @@ std::vector<Partner> contact_partners(const SceneDescription& sc) {
     d.kind = ObjectKind::Kinematic;
     out.push_back({t.name, make_rigid_object(d).field, true});
   }
+  for (size_t i = 0; i < sc.tools.size(); ++i)
+    if (!sc.tools[i].has_shape && !sc.tools[i].sensors.empty())
+      out.push_back({sc.tools[i].name, std::make_shared<geometry::SphereSdf>(0.001), true, int(i)});
   return out;
 }
 
@@ -144,7 +151,8 @@ void summarize(SceneContactPair& p, double threshold) {
 void check_scene_contact_bench(const SceneDescription& sc) {
   check_scene_reference(sc);
   require(!contact_partners(sc).empty(), scene_name(sc), ": body '", sc.bodies.at(0).name,
-          "' touches no object and no tool with a shape (contact.pairs); bench-contact compares contact forces");
+          "' touches no object and no tool with a shape (contact.pairs) and no tool grasps; bench-contact compares "
+          "contact and grasp forces");
 }
 
 SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, const SceneContactBenchSettings& set) {
@@ -169,6 +177,8 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
     res.removed += (res.removed.empty() ? "" : ", ") + p.name;
   }
   const size_t np = partners.size();
+  size_t n_obstacles = 0;  // the partners with a shape come first (contact_partners)
+  for (const Partner& p : partners) n_obstacles += p.grasp_tool < 0;
 
   // The full-FEM reference: forces, dents and obstacle positions per step.
   std::vector<double> ms_full;
@@ -179,20 +189,22 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
     ro.progress = set.progress;
     ro.on_step = [&](const SceneReferenceStep& s) {
       const FullFemReport& rep = *s.report;
-      require(rep.contacts.size() == np, where, ": the full-FEM reference has ", rep.contacts.size(),
-              " obstacles, expected ", np);
+      require(rep.contacts.size() == n_obstacles, where, ": the full-FEM reference has ", rep.contacts.size(),
+              " obstacles, expected ", n_obstacles);
       require(s.fem->displacement().allFinite(), where, ": the full-FEM reference became non-finite at step ", s.step,
               " (t = ", s.time, " s)");
       const Points x = s.fem->posed_surface(), u = s.fem->soft_displacement();
       bool any = false;
       for (size_t i = 0; i < np; ++i) {
-        const Vec3 f = rep.contacts[i].force;
-        require(f.allFinite(), where, ": the full-FEM contact force of '", partners[i].name,
+        const int tool = partners[i].grasp_tool;
+        const Vec3 f = tool < 0 ? rep.contacts[i].force : s.tool_forces->at(size_t(tool));
+        const Isometry& pose = tool < 0 ? s.obstacle_poses->at(i) : s.tool_poses->at(size_t(tool));
+        require(f.allFinite(), where, ": the full-FEM ", tool < 0 ? "contact" : "grasp", " force of '", partners[i].name,
                 "' became non-finite at step ", s.step, " (t = ", s.time, " s)");
         force_full[i].push_back(f);
-        position[i].push_back(s.obstacle_poses->at(i).translation());
+        position[i].push_back(pose.translation());
         res.pairs[i].force_full_n.push_back(f.norm());
-        res.pairs[i].dent_full_mm.push_back(1e3 * near_dent(x, u, *partners[i].field, s.obstacle_poses->at(i), set.dent_reach));
+        res.pairs[i].dent_full_mm.push_back(1e3 * near_dent(x, u, *partners[i].field, pose, set.dent_reach));
         any = any || f.norm() > 0;
       }
       res.time.push_back(s.time);
@@ -221,6 +233,9 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
       for (size_t j = 0; j < header.objects.size(); ++j)
         if (header.objects[j].name == partners[i].name) object_index[i] = int(j);
     const int body = session.body_model_index(0);
+    for (const Partner& p : partners)
+      require(p.grasp_tool < 0 || session.tool_index(p.name) == p.grasp_tool, where, ": tools '", p.name,
+              "' is not the scene's tool ", p.grasp_tool);
     SceneRunOptions ro;
     ro.progress = set.progress;
     ro.keep_frames = false;
@@ -234,20 +249,23 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
         const std::string term = "contact:" + partners[i].name;
         double force = 0;
         int nodes = 0;
+        const int tool = partners[i].grasp_tool;
         for (const TermQuantityReport& q : rep.quantities) {
-          if (q.term != term || q.body != body) continue;
+          if (tool >= 0 || q.term != term || q.body != body) continue;
           if (q.name == "force" && q.value.size() == 3) force = Vec3(q.value[0], q.value[1], q.value[2]).norm();
           if (q.name == "patch_nodes" && q.value.size() == 1) nodes = int(q.value[0]);
         }
-        require(std::isfinite(force), where, ": the reduced contact force of '", partners[i].name,
-                "' became non-finite at step ", ms_with.size());
+        if (tool >= 0) force = session.tool_state(tool).force.norm();  // on the tool: its anchors
+        require(std::isfinite(force), where, ": the reduced ", tool < 0 ? "contact" : "grasp", " force of '",
+                partners[i].name, "' became non-finite at step ", ms_with.size());
         SceneContactPair& p = res.pairs[i];
         p.force_reduced_n.push_back(force);
         p.patch_nodes.push_back(nodes);
+        const bool placed = tool >= 0 || object_index[i] >= 0;
+        const Isometry pose = tool >= 0 ? session.tool_state(tool).pose
+                                        : object_index[i] >= 0 ? poses.at(size_t(object_index[i])) : Isometry::Identity();
         p.dent_reduced_mm.push_back(
-            object_index[i] < 0 ? 0.0
-                                : 1e3 * near_dent(fr.positions, fr.displacement, *partners[i].field,
-                                                  poses.at(size_t(object_index[i])), set.dent_reach));
+            placed ? 1e3 * near_dent(fr.positions, fr.displacement, *partners[i].field, pose, set.dent_reach) : 0.0);
         any = any || force > 0;
       }
       contact_with.push_back(any);

@@ -56,7 +56,9 @@ SceneDescription reference_scene(const SceneDescription& sc) {
               << "': --solver full prescribes the bones from the motion (bones: dynamic runs as kinematic)\n";
     out.bodies[0].bones_dynamic = false;
   }
-  if (out.contact.friction > 0 && (!out.objects.empty() || !out.tools.empty()))
+  bool obstacles = !out.objects.empty();
+  for (const ToolDescription& t : out.tools) obstacles = obstacles || t.has_shape;
+  if (out.contact.friction > 0 && obstacles)
     std::cerr << "warning: " << where << ": --solver full is frictionless (contact.friction "
               << out.contact.friction << " is dropped)\n";
   return out;
@@ -220,7 +222,11 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
       ms_since_frame = 0;
       steps_since_frame = 0;
     }
-    if (opt.on_step) opt.on_step({k + 1, t, &fem, &rep, &poses, &tool_forces, cpu_ms});
+    if (opt.on_step) {
+      std::vector<Isometry> tool_poses;
+      for (int i = 0; i < session.num_tools(); ++i) tool_poses.push_back(session.tool_state(i).pose);
+      opt.on_step({k + 1, t, &fem, &rep, &poses, &tool_forces, &tool_poses, cpu_ms});
+    }
     if (opt.progress) progress.update(k + 1);
   }
   if (opt.progress) progress.finish();

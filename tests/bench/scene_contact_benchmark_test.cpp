@@ -19,6 +19,7 @@
 #include "sflsh/reference/scene_reference_run.hpp"
 #include "sflsh/scene/scene_description.hpp"
 #include "sflsh/scene/scene_run.hpp"
+#include "sflsh/scene/scene_session.hpp"
 #include "test_support.hpp"
 
 using namespace sflsh;
@@ -51,6 +52,55 @@ SceneContactBenchSettings quiet() {
 }
 
 }  // namespace
+
+// A kinematic tool without a shape that grasps (it lifts the top by 3 mm and
+// lets go): compared by the force on the tool, per step the |force| of
+// `simulate --solver full`'s tool and of the reduced session's tool state.
+TEST_F(SceneContactBench, AGraspingToolIsComparedByTheForceOnTheTool) {
+  const std::string text = R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
+output: {fps: 20}
+bodies:
+  - {name: base, avatar: box.h5, motion: none, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.002, 0.04, 0.001], closure: 0.8}
+      - {time: 0.05, position: [0.002, 0.04, 0.001], closure: 0.0}
+      - {time: 0.15, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.24, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.25, position: [0.002, 0.043, 0.001], closure: 0.8}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
+      hardness: 2.0e3
+)";
+  const SceneDescription sc = read_scene_description(write_scene(text));
+  Progress::set_quiet(true);
+  const SceneContactBenchResult r = run_scene_contact_bench(sc, quiet());
+  std::vector<double> full;
+  SceneReferenceOptions fo;
+  fo.progress = false;
+  fo.on_step = [&](const SceneReferenceStep& s) { full.push_back(s.tool_forces->at(0).norm()); };
+  run_scene_reference(sc, fo);
+  std::vector<double> reduced;
+  SceneSessionOptions so;
+  so.progress = false;
+  SceneSession session(sc, so);
+  while (session.steps_done() < session.total_steps()) {
+    session.advance();
+    reduced.push_back(session.tool_state(0).force.norm());
+  }
+  Progress::set_quiet(false);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const SceneContactPair& p = r.pairs[0];
+  EXPECT_EQ(p.object, "gripper");
+  EXPECT_EQ(r.removed, "gripper");
+  EXPECT_EQ(p.force_full_n, full);
+  ASSERT_EQ(p.force_reduced_n.size(), reduced.size());
+  for (size_t k = 0; k < reduced.size(); ++k) EXPECT_NEAR(p.force_reduced_n[k], reduced[k], 1e-9 * (1 + reduced[k])) << k;
+  EXPECT_GT(p.peak_full_n, 0.2);
+  EXPECT_GT(p.dent_full_max_mm, 1.0);  // the skin lifted under the tool
+  EXPECT_EQ(p.force_full_n.back(), 0.0);  // released
+}
 
 TEST_F(SceneContactBench, FiguresAreThoseOfBothSolversRunsAndTheDepthIsTheBallsTravel) {
   const SceneDescription sc = read_scene_description(write_scene(ball_scene("kinematic", kLowered)));
@@ -164,7 +214,7 @@ TEST_F(SceneContactBench, AStaticObjectHasNoDepthAndRefusedOrNonFiniteScenesFail
   refused(head + "objects:\n  - {name: rock, shape: {type: sphere, radius: 0.01}, kind: dynamic, density: 1000, "
                  "position: [0, 0.1, 0]}\n",
           {"scene.yaml", "objects 'rock'", "dynamic"});
-  refused(head, {"scene.yaml", "touches no object"});
+  refused(head, {"scene.yaml", "touches no object", "no tool grasps"});
   // The full FEM never touches the ball: nothing to compare.
   const SceneDescription apart =
       read_scene_description(write_scene(ball_scene("static", "    position: [0.0, 0.1, 0.0]\n")));

@@ -39,6 +39,7 @@ struct SceneReferenceStep {
   /// N, world, one per tool of the scene: what the body exerts on it through
   /// its anchors (zero for a tool that does not grasp).
   const std::vector<Vec3>* tool_forces = nullptr;
+  const std::vector<Isometry>* tool_poses = nullptr;  ///< world, one per tool of the scene, at the step's end
   double cpu_ms = 0;                                ///< thread CPU time of the reference's step
 };
 
