@@ -46,7 +46,7 @@ describe() {
   case $1 in
     avatar) echo "the default avatar (work file; quick: K = 16)" ;;
     bench) echo "bench.md bench.csv bench.svg: sflsh bench against the full FEM" ;;
-    contact) echo "contact_patch.md contact_patch_probe.svg: sflsh bench-contact, three probes, a pressed sphere, an impact, a box press" ;;
+    contact) echo "contact_patch.md contact_patch_probe.svg: sflsh bench-contact, three probes, a pressed sphere, an impact, a box press, a pinch" ;;
     hertz) echo "hertz.md: the full FEM against Hertz (test_reference)" ;;
     stress) echo "stress.csv stress.svg: sflsh stress, shake at dt 1/30" ;;
     stress_suite) echo "stress_suite.md .csv .svg: sflsh stress-suite" ;;
@@ -185,7 +185,7 @@ for step in $STEPS; do
       run "$SFLSH" bench-contact --quick --handles 16 --scenes probe --out "$d"
     else
       run "$SFLSH" bench-contact --handles 96 --scenes probe,probe-belly,probe-calf-1cm,pressed,impact --cpu-time \
-        --scene apps/scenes/figures/box_press_belly.yaml --out "$d"
+        --scene apps/scenes/figures/box_press_belly.yaml --scene apps/scenes/figures/pinch_from_file.yaml --out "$d"
     fi
     stamp "$d/contact_bench.md" "$OUT/contact_patch.md"
     stamp "$d/contact_probe.svg" "$OUT/contact_patch_probe.svg" ;;
