@@ -136,7 +136,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     fr.contacts = contacts;
     for (size_t i = 0; i < fr.tools.size() && i < tool_forces.size(); ++i) {
       fr.tools[i].force = tool_forces[i];
-      fr.tools[i].torque.setZero();  // the reference reports the anchors' force only
+      fr.tools[i].torque.setZero();  // the reference reports forces only
     }
     r.add_frame(std::move(fr));
     r.tool_events = tool_events;
@@ -191,11 +191,15 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     const double cpu_ms = thread_cpu_ms() - cpu0;
     const double t = (k + 1) * session.dt();
     if (!rep.converged) ++not_converged;
-    for (const ReferenceGrasp& g : grasps) {
-      Vec3 f = Vec3::Zero();  // on the tool: the anchors' reaction
-      for (size_t i = g.first; i < g.first + g.count; ++i) f -= rep.anchor_forces.at(i);
-      tool_forces[size_t(g.tool)] = f;
+    // On each tool: its shape's contact reaction and its anchors'.
+    for (int i = 0; i < session.num_tools(); ++i) {
+      Vec3 f = Vec3::Zero();
+      for (size_t o = 0; o < rep.contacts.size(); ++o)
+        if (rep.contacts[o].name == session.tool_name(i)) f -= rep.contacts[o].force;
+      tool_forces[size_t(i)] = f;
     }
+    for (const ReferenceGrasp& g : grasps)
+      for (size_t i = g.first; i < g.first + g.count; ++i) tool_forces[size_t(g.tool)] -= rep.anchor_forces.at(i);
     for (size_t i = 0; i < rep.contacts.size(); ++i) {
       SceneContactStats::Pair& p = st.pairs[i];
       const FullFemContact& c = rep.contacts[i];

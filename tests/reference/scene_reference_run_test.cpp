@@ -98,6 +98,10 @@ TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject)
   ASSERT_EQ(ra.num_frames, rb.num_frames);
   EXPECT_EQ(ra.frame_positions.back(), rb.frame_positions.back());
   EXPECT_EQ(a.pairs.at(0).last_force, b.pairs.at(0).last_force);
+  // The tool's frames carry the reference's reaction on it: the opposite of its contact force on the body.
+  ASSERT_EQ(rb.tools.size(), 1u);
+  EXPECT_EQ(rb.tools[0].frames.back().force, Vec3(-b.pairs.at(0).last_force));
+  EXPECT_GT(b.pairs.at(0).last_force.norm(), 0.05);
   EXPECT_GT(a.pairs.at(0).max_force, 0.05);
 }
 

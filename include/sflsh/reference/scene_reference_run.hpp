@@ -37,7 +37,7 @@ struct SceneReferenceStep {
   const FullFemReport* report = nullptr;            ///< contacts: one per obstacle, in the stats' pair order
   const std::vector<Isometry>* obstacle_poses = nullptr;  ///< world, one per obstacle
   /// N, world, one per tool of the scene: what the body exerts on it through
-  /// its anchors (zero for a tool that does not grasp).
+  /// its shape's contact and its anchors.
   const std::vector<Vec3>* tool_forces = nullptr;
   const std::vector<Isometry>* tool_poses = nullptr;  ///< world, one per tool of the scene, at the step's end
   double cpu_ms = 0;                                ///< thread CPU time of the reference's step
