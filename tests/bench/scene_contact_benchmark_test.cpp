@@ -57,23 +57,7 @@ SceneContactBenchSettings quiet() {
 // lets go): compared by the force on the tool, per step the |force| of
 // `simulate --solver full`'s tool and of the reduced session's tool state.
 TEST_F(SceneContactBench, AGraspingToolIsComparedByTheForceOnTheTool) {
-  const std::string text = R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
-output: {fps: 20}
-bodies:
-  - {name: base, avatar: box.h5, motion: none, bones: kinematic}
-tools:
-  - name: gripper
-    keyframes:
-      - {time: 0.0, position: [0.002, 0.04, 0.001], closure: 0.8}
-      - {time: 0.05, position: [0.002, 0.04, 0.001], closure: 0.0}
-      - {time: 0.15, position: [0.002, 0.043, 0.001], closure: 0.0}
-      - {time: 0.24, position: [0.002, 0.043, 0.001], closure: 0.0}
-      - {time: 0.25, position: [0.002, 0.043, 0.001], closure: 0.8}
-    grasp:
-      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
-      hardness: 2.0e3
-)";
-  const SceneDescription sc = read_scene_description(write_scene(text));
+  const SceneDescription sc = read_scene_description(write_scene(test::kBoxPinchScene));
   Progress::set_quiet(true);
   const SceneContactBenchResult r = run_scene_contact_bench(sc, quiet());
   std::vector<double> full;

@@ -113,24 +113,7 @@ TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject)
 // and scale as the reduced run's force on the box's 6-handle basis), and
 // nothing after the release.
 TEST_F(SceneReference, AToolGraspsTheReferencesSkinLiftsItAndLetsGo) {
-  const std::string text = R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
-output: {fps: 20}
-bodies:
-  - {name: base, avatar: box.h5, bones: kinematic}
-tools:
-  - name: gripper
-    keyframes:
-      - {time: 0.0, position: [0.002, 0.04, 0.001], closure: 0.8}
-      - {time: 0.05, position: [0.002, 0.04, 0.001], closure: 0.0}
-      - {time: 0.15, position: [0.002, 0.043, 0.001], closure: 0.0}
-      - {time: 0.24, position: [0.002, 0.043, 0.001], closure: 0.0}
-      - {time: 0.25, position: [0.002, 0.043, 0.001], closure: 0.8}
-    grasp:
-      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
-      hardness: 2.0e3
-      damping: 1.0
-)";
-  const SceneDescription sc = read_scene_description(write_scene(text));
+  const SceneDescription sc = read_scene_description(write_scene(test::kBoxPinchScene));
   std::vector<Vec3> force_full;
   SceneReferenceOptions o = quiet();
   o.on_step = [&](const SceneReferenceStep& s) {

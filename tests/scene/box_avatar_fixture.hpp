@@ -43,4 +43,25 @@ class BoxAvatarScene : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
+/// A kinematic tool without a shape whose grasp sensor looks down at the
+/// box's top from 1 cm above it: it closes at 0.05 s, lifts 3 mm by 0.15 s,
+/// holds, and opens at 0.25 s (dt 1/100, 0.3 s, gravity off, hardness 2e3 N/m).
+inline constexpr const char* kBoxPinchScene = R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
+output: {fps: 20}
+bodies:
+  - {name: base, avatar: box.h5, motion: none, bones: kinematic}
+tools:
+  - name: gripper
+    keyframes:
+      - {time: 0.0, position: [0.002, 0.04, 0.001], closure: 0.8}
+      - {time: 0.05, position: [0.002, 0.04, 0.001], closure: 0.0}
+      - {time: 0.15, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.24, position: [0.002, 0.043, 0.001], closure: 0.0}
+      - {time: 0.25, position: [0.002, 0.043, 0.001], closure: 0.8}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
+      hardness: 2.0e3
+      damping: 1.0
+)";
+
 }  // namespace sflsh::test
