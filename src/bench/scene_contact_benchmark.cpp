@@ -28,10 +28,10 @@ const std::string& scene_name(const SceneDescription& sc) {
 /// An object or tool with a shape that touches the body: what the reference
 /// makes an obstacle of, in its order (objects, then tools); then the tools
 /// without a shape that grasp (compared by the force on the tool, their
-/// "dent" the skin's largest |u| near the tool's origin).
+/// "dent" the skin's largest |u| within reach of a sensor's end: the lifted skin).
 struct Partner {
   std::string name;
-  geometry::SdfPtr field;  // shape frame (a grasping tool: a 1 mm ball at its origin)
+  geometry::SdfPtr field;  // shape frame (a grasping tool: a ball over its sensors' reach at its origin)
   bool kinematic = false;
   int grasp_tool = -1;     // a grasping tool: its index in the scene's tools
 };
@@ -59,9 +59,13 @@ std::vector<Partner> contact_partners(const SceneDescription& sc) {
     d.kind = ObjectKind::Kinematic;
     out.push_back({t.name, make_rigid_object(d).field, true});
   }
-  for (size_t i = 0; i < sc.tools.size(); ++i)
-    if (!sc.tools[i].has_shape && !sc.tools[i].sensors.empty())
-      out.push_back({sc.tools[i].name, std::make_shared<geometry::SphereSdf>(0.001), true, int(i)});
+  for (size_t i = 0; i < sc.tools.size(); ++i) {
+    const ToolDescription& t = sc.tools[i];
+    if (t.has_shape || t.sensors.empty()) continue;
+    double reach = 0;
+    for (const ToolSensorDescription& s : t.sensors) reach = std::max(reach, s.origin.norm() + s.range);
+    out.push_back({t.name, std::make_shared<geometry::SphereSdf>(reach), true, int(i)});
+  }
   return out;
 }
 

@@ -97,7 +97,7 @@ void write_scene_contact_markdown(const std::vector<SceneContactBenchResult>& re
       "Scene files: each run as written by the reduced solver (the scene loop of `sflsh simulate`; its contact is "
       "the scene's contact.patch, or the per-sample penalty without it) and by the full-FEM reference (`sflsh simulate "
       "--solver full`: face samples with the scene's pressure stiffness, frictionless), compared per contact pair and "
-      "per grasping tool (the force on the tool through its anchors; its dent: the skin near the tool's origin) at "
+      "per grasping tool (the force on the tool through its anchors; its dent: the skin within its sensors' reach) at "
       "every step. Peak force: the largest |contact force on the body| over the steps, its error |reduced − full| / "
       "full; RMS error: of (F_red − F_full) / F_full over the steps where the full FEM's force is above %.0f %% of its "
       "peak (steps counted); dent: the largest soft displacement |u| of the skin within %.0f mm of the object's "
