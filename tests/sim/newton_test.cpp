@@ -294,7 +294,9 @@ TEST(Newton, TermsLeftOutOfTheNonlinearityCheckDoNotAddIterations) {
     q.z = VecX::Zero(3);
     const StepReport rep = newton_minimize({&quadratic, &unit}, ctx, q, o);
     EXPECT_EQ(rep.iterations_for_nonlinearity, left_out ? 0 : 1) << "left out " << left_out;
-    if (left_out) EXPECT_NEAR(q.z[1], 0.5, 1e-15);
+    if (left_out) {
+      EXPECT_NEAR(q.z[1], 0.5, 1e-15);
+    }
   }
   QuarticTerm nonlinear, left_out;
   nonlinear.b = 4;

@@ -83,11 +83,13 @@ SkinPoint closest_skin_point(const Vec3& x, const SkinContactTerm::Skin& to, con
   for (int u : to.vertex_neighbours[w]) faces.insert(faces.end(), to.vertex_faces[u].begin(), to.vertex_faces[u].end());
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  auto closest_on = [&](int g, const Vec3& y) {  // barycentric coordinates of face g's point closest to y
+    return geometry::closest_point_on_triangle(y, x_to.row(to.faces(g, 0)).transpose(),
+                                               x_to.row(to.faces(g, 1)).transpose(), x_to.row(to.faces(g, 2)).transpose());
+  };
   SkinPoint p;
   for (int g : faces) {
-    const Vec3 mu = geometry::closest_point_on_triangle(x, x_to.row(to.faces(g, 0)).transpose(),
-                                                        x_to.row(to.faces(g, 1)).transpose(),
-                                                        x_to.row(to.faces(g, 2)).transpose());
+    const Vec3 mu = closest_on(g, x);
     const double d = (x - face_point(x_to, to.faces, g, mu)).norm();
     if (d < p.distance) {
       p.distance = d;
@@ -101,12 +103,9 @@ SkinPoint closest_skin_point(const Vec3& x, const SkinContactTerm::Skin& to, con
   if ((p.mu.array() <= 0).any() && p.distance > 1e-9) {
     Vec3 side = Vec3::Zero();  // the faces at the closest point: those as close (to round-off)
     const Vec3 y = x - offset;
-    for (int g : faces) {
-      const Vec3 mu = geometry::closest_point_on_triangle(y, x_to.row(to.faces(g, 0)).transpose(),
-                                                          x_to.row(to.faces(g, 1)).transpose(),
-                                                          x_to.row(to.faces(g, 2)).transpose());
-      if ((y - face_point(x_to, to.faces, g, mu)).norm() <= 1e-9 * (1.0 + p.distance)) side += face_normal(x_to, to.faces, g);
-    }
+    for (int g : faces)
+      if ((y - face_point(x_to, to.faces, g, closest_on(g, y))).norm() <= 1e-9 * (1.0 + p.distance))
+        side += face_normal(x_to, to.faces, g);
     p.normal = (side.dot(offset) < 0 ? -1.0 : 1.0) * offset / p.distance;
   }
   return p;
