@@ -29,6 +29,8 @@ TEST(ContactBenchCli, BadInputFailsWithOneClearLineAndNoOutput) {
       {"bench-contact --spacing 0" + out, {"--spacing", "spacing 0"}},
       {"bench-contact --patch-radius 0" + out, {"--patch-radius", "positive"}},
       {"bench-contact --patch-radius nan" + out, {"--patch-radius", "positive"}},
+      {"bench-contact --max-patch-nodes 0" + out, {"--max-patch-nodes", "1 to 1000000"}},
+      {"bench-contact --max-patch-nodes 2.5" + out, {"--max-patch-nodes"}},
       {"bench-contact --out " + dir.file("plain_file"), {"--out", "plain_file", "not a folder"}},
   };
   for (const auto& c : cases) {
