@@ -255,7 +255,14 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
         int nodes = 0;
         const int tool = partners[i].grasp_tool;
         for (const TermQuantityReport& q : rep.quantities) {
-          if (tool >= 0 || q.term != term || q.body != body) continue;
+          if (q.body != body) continue;
+          if (tool >= 0) {  // a grasping tool's patch: its anchor terms'
+            const std::vector<int>& at = session.compiled_tool(tool).anchor_terms;
+            if (q.name == "patch_nodes" && q.value.size() == 1 && std::count(at.begin(), at.end(), q.term_index))
+              nodes = std::max(nodes, int(q.value[0]));
+            continue;
+          }
+          if (q.term != term) continue;
           if (q.name == "force" && q.value.size() == 3) force = Vec3(q.value[0], q.value[1], q.value[2]).norm();
           if (q.name == "patch_nodes" && q.value.size() == 1) nodes = int(q.value[0]);
         }

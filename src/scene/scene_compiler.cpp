@@ -122,6 +122,16 @@ std::vector<CompiledObject> add_objects(ModelBuilder& mb, const SceneDescription
   return objects;
 }
 
+/// The scene's contact.patch settings as the patch term's options.
+ContactPatchOptions patch_options(const ContactDescription& c) {
+  ContactPatchOptions po;
+  po.pressure_stiffness = c.pressure_stiffness;
+  po.spacing = c.patch_spacing;
+  po.patch_radius = c.patch_radius;
+  po.max_patch_nodes = c.max_patch_nodes;
+  return po;
+}
+
 /// A rigid shape touching body `b`: with `patch` the face-sampled contact and
 /// its pressure patch, else the per-skin-sample penalty with friction. The
 /// shape is the world frame `frame` (static or kinematic) or, `dynamic`, the
@@ -132,12 +142,7 @@ int add_shape_contact(ModelBuilder& mb, const CompiledBody& b, const std::string
                        bool patch, const ContactDescription& c, SkinSamples& samples) {
   std::shared_ptr<const EnergyTerm> term;
   if (patch) {
-    ContactPatchOptions po;
-    po.pressure_stiffness = c.pressure_stiffness;
-    po.spacing = c.patch_spacing;
-    po.patch_radius = c.patch_radius;
-    po.max_patch_nodes = c.max_patch_nodes;
-    term = std::make_shared<const ContactPatchTerm>(frame, *b.avatar, field, shape_in_body, dynamic, po);
+    term = std::make_shared<const ContactPatchTerm>(frame, *b.avatar, field, shape_in_body, dynamic, patch_options(c));
   } else {
     auto& pts = samples[b.avatar.get()];
     if (!pts) pts = std::make_shared<const PosedPoints>(skin_contact_samples(*b.avatar, c.sample_spacing));
@@ -180,7 +185,10 @@ RigidObjectModel tool_shape(const std::string& name, const ShapeDescription& sha
 /// Adds a tool: with `coupling` a rigid body pulled by a virtual coupling;
 /// contact with every body through its shape and jaws (with contact.patch a
 /// kinematic tool gets the face-sampled contact, a coupled one keeps the
-/// per-sample penalty); with sensors one anchor term per body for grasping.
+/// per-sample penalty); with sensors one anchor term per body for grasping
+/// (with contact.patch and a kinematic tool, the anchors join the patch of
+/// the tool's shape, or get their own: one patch under the tool, whose
+/// displacement the shape and the anchors share).
 /// Records the tool's input ids and the terms that act on it.
 CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vector<CompiledBody>& bodies,
                       const ContactDescription& c, SkinSamples& samples) {
@@ -214,16 +222,28 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
   t.grasp.closure_threshold = d.closure_threshold;
   const bool patch = c.patch && !coupled;
   for (const CompiledBody& b : bodies) {
-    if (d.has_shape)
+    const std::string anchor_set = d.name + "@" + b.desc->name;
+    const AnchorOptions anchor_options{d.hardness, d.damping};
+    const bool grasps = !d.sensors.empty();
+    if (patch && grasps) {
+      // One patch under the tool: its shape's contact (if any) and its anchors.
+      auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, d.has_shape ? t.shape.field : nullptr,
+                                                           Isometry::Identity(), false, patch_options(c),
+                                                           PatchAnchors{anchor_set, anchor_options});
+      const int index = mb.add_term(term, {b.model_index});
+      t.anchor_terms.push_back(index);
+      if (d.has_shape) t.contact_terms.push_back(index);
+      t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
+    } else if (d.has_shape) {
       t.contact_terms.push_back(add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));
+    }
     for (const CompiledJaw& jaw : t.jaws)
       t.contact_terms.push_back(add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));
-    if (d.sensors.empty()) continue;
-    const std::string anchor_set = d.name + "@" + b.desc->name;
+    if (!grasps || patch) continue;
     auto term = std::make_shared<const AnchorTerm>(anchor_set, PosedPoints::at_surface(*b.avatar), coupled,
-                                                   AnchorOptions{d.hardness, d.damping});
+                                                   anchor_options);
     t.anchor_terms.push_back(coupled ? mb.add_term(term, {b.model_index, t.model_index})
                                      : mb.add_term(term, {b.model_index}));
     t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));

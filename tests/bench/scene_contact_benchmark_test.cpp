@@ -86,6 +86,29 @@ TEST_F(SceneContactBench, AGraspingToolIsComparedByTheForceOnTheTool) {
   EXPECT_EQ(p.force_full_n.back(), 0.0);  // released
 }
 
+// The same pinch with contact.patch: the anchors pull through a patch under
+// the tool (contact_patch.hpp, PatchAnchors), whose tent the 6 handles
+// cannot form alone; the force on the tool comes near the full FEM's.
+TEST_F(SceneContactBench, WithThePatchAGraspingToolsForceComesNearTheFullFem) {
+  std::string text = test::kBoxPinchScene;
+  text.insert(text.find('\n') + 1, "contact: {patch: true, friction: 0}\n");
+  Progress::set_quiet(true);
+  const SceneContactBenchResult without = run_scene_contact_bench(read_scene_description(write_scene(test::kBoxPinchScene)), quiet());
+  const SceneContactBenchResult with = run_scene_contact_bench(read_scene_description(write_scene(text)), quiet());
+  Progress::set_quiet(false);
+  ASSERT_EQ(with.pairs.size(), 1u);
+  ASSERT_EQ(without.pairs.size(), 1u);
+  const SceneContactPair &p = with.pairs[0], &q = without.pairs[0];
+  std::cout << "[ pinch patch ] peak full " << p.peak_full_n << " N, with patch " << p.peak_reduced_n << " N (rms "
+            << p.rms_err << ", " << p.max_patch_nodes << " nodes), without " << q.peak_reduced_n << " N (rms " << q.rms_err
+            << ")\n";
+  EXPECT_EQ(p.peak_full_n, q.peak_full_n);  // the reference does not see contact.patch
+  EXPECT_GT(p.max_patch_nodes, 0);
+  EXPECT_EQ(q.max_patch_nodes, 0);
+  EXPECT_LT(p.rms_err, 0.25);
+  EXPECT_LT(p.rms_err, 0.5 * q.rms_err);
+}
+
 TEST_F(SceneContactBench, FiguresAreThoseOfBothSolversRunsAndTheDepthIsTheBallsTravel) {
   const SceneDescription sc = read_scene_description(write_scene(ball_scene("kinematic", kLowered)));
   Progress::set_quiet(true);

@@ -181,7 +181,7 @@ TEST_F(SceneCompileGolden, PinchBelly) {
   check({"pinch_belly.yaml", at_belly, 40,
          {"inertia@0; elastic@0; gravity@0; anchor:gripper@alice@0",
           "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
-          "792ef903953b7ef5", "a44b4a48eea008cc", "616b08f3261f6977", 1}});
+          "792ef903953b7ef5", "542c6c2162f1e9f4", "1d79ae60ea801307", 1}});
 }
 
 TEST_F(SceneCompileGolden, TeleopPinch) {
@@ -251,7 +251,7 @@ TEST_F(SceneCompileGolden, PinchFromFile) {
   check({"figures/pinch_from_file.yaml", at_belly, 40,
          {"inertia@0; elastic@0; gravity@0; anchor:gripper@alice@0",
           "alice:0/24/18@0 dofs 18 blocks 1 groups 1",
-          "792ef903953b7ef5", "a44b4a48eea008cc", "616b08f3261f6977", 1}});
+          "792ef903953b7ef5", "542c6c2162f1e9f4", "1d79ae60ea801307", 1}});
 }
 
 TEST_F(SceneCompileGolden, SlabOnBelly) {

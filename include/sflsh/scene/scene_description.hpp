@@ -42,8 +42,9 @@
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
 //     patch:                    # contact that dents (static and kinematic objects, tools; needs
 //                               # friction: 0): a pressure over the skin's faces and a full-space
-//                               # patch under it (sim/energies/contact_patch.hpp); `patch: true`
-//                               # takes the defaults; default off
+//                               # patch under it (sim/energies/contact_patch.hpp), also under a
+//                               # kinematic tool's grasp anchors; `patch: true` takes the
+//                               # defaults; default off
 //       radius: 0.04            # m: nodes within it of the near skin; grows to 1.5 contact radii
 //       max_nodes: 120          # nodes in one patch at most (>= 1)
 //       pressure_stiffness: 1.0e8   # N/m³ (> 0)
@@ -299,8 +300,10 @@ struct ContactDescription {
   /// pressure stiffness, and a full-space patch under it
   /// (sim/energies/contact_patch.hpp), for static and kinematic objects.
   /// Frictionless: refused with friction > 0; a dynamic object is refused
-  /// when the scene is built. Kinematic tools (and their jaws) get it too;
-  /// coupled tools keep the per-sample penalty.
+  /// when the scene is built. Kinematic tools (and their jaws) get it too,
+  /// their grasp anchors in the patch of the tool's shape (or a patch of
+  /// their own: PatchAnchors); coupled tools keep the per-sample penalty and
+  /// anchors on the subspace.
   bool patch = false;
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
   int max_patch_nodes = ContactPatchOptions().max_patch_nodes;

@@ -28,15 +28,26 @@ using contact_patch_detail::PatchCache;
 using contact_patch_detail::PatchHistory;
 
 ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry::SdfPtr field,
-                                   const Isometry& shape_in_frame, bool dynamic_object, const ContactPatchOptions& o)
+                                   const Isometry& shape_in_frame, bool dynamic_object, const ContactPatchOptions& o,
+                                   std::optional<PatchAnchors> anchors)
     : object_(std::move(object)),
       avatar_(&a),
       field_(std::move(field)),
       shape_in_frame_(shape_in_frame),
       dynamic_(dynamic_object),
-      options_(o) {
+      options_(o),
+      anchors_(std::move(anchors)) {
   const std::string what = "contact with '" + object_ + "'";
-  require(field_ != nullptr, what, ": no field");
+  require(field_ != nullptr || anchors_, what, ": no field and no anchors");
+  if (anchors_) {
+    require(!dynamic_, what, ": anchors in a patch take a kinematic tool (a dynamic one: AnchorTerm)");
+    require(!anchors_->set.empty(), what, ": the anchor set has no name");
+    const AnchorOptions& ao = anchors_->options;
+    require(ao.hardness > 0 && std::isfinite(ao.hardness), what, ": anchor hardness ", ao.hardness,
+            " N/m, expected > 0");
+    require(ao.damping >= 0 && std::isfinite(ao.damping), what, ": anchor damping ", ao.damping,
+            " N·s/m, expected >= 0");
+  }
   check_contact_sampling(o.pressure_stiffness, o.spacing, what);
   require(std::isfinite(o.patch_radius) && o.patch_radius > 0, what, ": patch radius ", o.patch_radius,
           " m, expected a finite number > 0");
@@ -319,21 +330,11 @@ void ContactPatchTerm::prepare_bulk_hessian(TermCache& cache) const {
   c.bulk_tets = c.tets;
 }
 
-void ContactPatchTerm::begin_step(const StepContext& ctx) const {
-  PatchCache& c = patch_cache(ctx, name());
-  // The displacement fixed at the end of the last step becomes the one at t.
-  for (auto it = c.history.begin(); it != c.history.end();) {
-    PatchHistory& h = it->second;
-    h.d_prev = h.d_t;
-    h.d_t = h.d_next;
-    h.du_prev = h.du;
-    h.du = h.du_next;
-    const double rel = options_.release_displacement;
-    if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel)
-      it = c.history.erase(it);
-    else
-      ++it;
-  }
+/// The skin vertices near the object at time t (by increasing index) and
+/// their φ; also places the field at t + h (cache's field_pose).
+void ContactPatchTerm::find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
+                                          std::vector<double>& near_phi) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
   const geometry::Aabb local = field_->bounds();
   const bool bounded = !local.is_unbounded();
   const double extent = bounded ? 0.5 * (local.max - local.min).norm() : 1.0;
@@ -364,8 +365,6 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
                                          : ctx.bound[0];
   const Configuration& qt = *b.q_prev;
   const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
-  std::vector<int> near;
-  std::vector<double> near_phi;  // φ of each near vertex at t
   for (const VertexCluster& cl : clusters_) {
     // A cluster whose centre, carried by its bone, is farther from the object
     // than its radius (slack included) plus the reach holds no near vertex.
@@ -394,11 +393,36 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     near.swap(n2);
     near_phi.swap(p2);
   }
+}
+
+void ContactPatchTerm::begin_step(const StepContext& ctx) const {
+  PatchCache& c = patch_cache(ctx, name());
+  // The displacement fixed at the end of the last step becomes the one at t.
+  for (auto it = c.history.begin(); it != c.history.end();) {
+    PatchHistory& h = it->second;
+    h.d_prev = h.d_t;
+    h.d_t = h.d_next;
+    h.du_prev = h.du;
+    h.du = h.du_next;
+    const double rel = options_.release_displacement;
+    if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel)
+      it = c.history.erase(it);
+    else
+      ++it;
+  }
+  std::vector<int> near;
+  std::vector<double> near_phi;  // φ of each near vertex at t
+  if (field_) find_near_vertices(ctx, c, near, near_phi);
   collect_candidate_faces(c, near);
+  if (anchors_) collect_anchors(ctx, c, near, near_phi);
   select_patch_nodes(c, near, near_phi);
   prepare_patch_tets(c);
   prepare_bulk_hessian(c);
   // Predictions and the warm start.
+  const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
+                                         : ctx.bound[0];
+  const Configuration& qt = *b.q_prev;
+  const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
   const size_t P = c.nodes.size();
   c.x_star.assign(P, Vec3::Zero());
   c.d_pred.assign(P, Vec3::Zero());
@@ -428,7 +452,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
 
 bool ContactPatchTerm::active(const StepContext& ctx) const {
   const PatchCache& c = patch_cache(ctx, name());
-  return !c.faces.empty() || !c.nodes.empty();
+  return !c.faces.empty() || !c.nodes.empty() || !c.anchor_vertices.empty();
 }
 
 double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {

@@ -26,6 +26,8 @@ struct ContactPatchTerm::Evaluation {
   double point_weight = 0;        // Σ |f_s|
   int active = 0;
   double depth = 0, area = 0;
+  VecX anchor_forces;      // 3 per anchor (N, what the tool exerts on the flesh), with the anchors
+  double max_stretch = 0;  // m, the largest |x_p − a_p|
 };
 
 namespace contact_patch_detail {
@@ -81,6 +83,10 @@ struct PatchCache : TermCache {
   MatX Hpz;                     // Φ_pz (patch DoFs by z)
   Eigen::LLT<MatX> Hpp_llt;
   std::unordered_map<int, PatchHistory> history;
+  // The step's anchors (PatchAnchors), by increasing vertex: the tool point at
+  // t + h and at t, and the vertex (with its patch offset) at t; step frame.
+  std::vector<int> anchor_vertices;
+  std::vector<Vec3> anchor_target, anchor_a_t, anchor_x_t;
 };
 
 inline PatchCache& patch_cache(const StepContext& ctx, const std::string& name) {
@@ -91,6 +97,19 @@ inline PatchCache& patch_cache(const StepContext& ctx, const std::string& name) 
 inline const DofLayout& local_layout(const StepContext& ctx) {
   return ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
 }
+
+/// A skin vertex at q with the patch's displacement: x = x_v(q) + A offset,
+/// offset = Σ_c b_c δu_c over its tet's nodes (unposed), A = Σ_j w_j R_j.
+struct PatchedVertex {
+  Vec3 x = Vec3::Zero();
+  Mat3 A = Mat3::Identity();
+  Vec3 offset = Vec3::Zero();
+  std::array<std::pair<int, double>, 4> couple;  // (patch slot or −1, barycentric weight) per tet node
+};
+
+/// Vertex `v` of `vertices` (the term's skin points) at q with δu (slots of `c`).
+PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const PatchCache& c, int v,
+                             const Configuration& q, const VecX& du);
 
 /// Adds the generalized force of a world force `f` on an offset d = Σ_j w_j R_j o
 /// (o unposed) to the bones' rotations: ∂d/∂ω_j = −[w_j R_j o]×, so bone j's

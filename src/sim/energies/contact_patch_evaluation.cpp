@@ -20,6 +20,24 @@ using contact_patch_detail::add_offset_rotation_gradient;
 using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
+using contact_patch_detail::patched_vertex;
+using contact_patch_detail::PatchedVertex;
+
+namespace contact_patch_detail {
+PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const PatchCache& c, int v,
+                             const Configuration& q, const VecX& du) {
+  PatchedVertex p;
+  p.A = skinning_rotation_blend(a.surface_weights.row(v), q.bones);
+  const int t = a.surface_tet[v];
+  for (int k = 0; k < 4; ++k) {
+    const auto s = c.node_slot.find(a.tet.elements(t, k));
+    p.couple[size_t(k)] = {s == c.node_slot.end() ? -1 : s->second, a.surface_bary(v, k)};
+    if (s != c.node_slot.end()) p.offset += a.surface_bary(v, k) * du.segment<3>(3 * s->second);
+  }
+  p.x = vertices.world_point(v, q) + p.A * p.offset;
+  return p;
+}
+}  // namespace contact_patch_detail
 
 double ContactPatchTerm::subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
   const MaterialPoint& m = materials_[t];
@@ -78,7 +96,8 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
   const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);
   if (!std::isfinite(elasticity)) return out.energy = std::numeric_limits<double>::infinity();
-  return out.energy = inertia + elasticity + add_patch_contact(ctx, q, du, mode, out);
+  const double contact = field_ ? add_patch_contact(ctx, q, du, mode, out) : 0.0;
+  return out.energy = inertia + elasticity + contact + add_patch_anchors(ctx, q, du, mode, out);
 }
 
 double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configuration& q, const VecX& du,
@@ -282,17 +301,8 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   // Patch coupling of each vertex: (patch slot, barycentric weight) over its tet's nodes.
   std::vector<std::array<std::pair<int, double>, 4>> couple(nv);
   for (size_t i = 0; i < nv; ++i) {
-    const int v = c.vertices[i];
-    Av[i] = skinning_rotation_blend(a.surface_weights.row(v), q.bones);
-    Vec3 off = Vec3::Zero();
-    const int t = a.surface_tet[v];
-    for (int k = 0; k < 4; ++k) {
-      const auto s = c.node_slot.find(a.tet.elements(t, k));
-      couple[i][k] = {s == c.node_slot.end() ? -1 : s->second, a.surface_bary(v, k)};
-      if (couple[i][k].first >= 0) off += couple[i][k].second * du.segment<3>(3 * couple[i][k].first);
-    }
-    offset[i] = off;
-    xv[i] = vertices_.world_point(v, q) + Av[i] * off;
+    const PatchedVertex pv = patched_vertex(a, vertices_, c, c.vertices[i], q, du);
+    xv[i] = pv.x, Av[i] = pv.A, offset[i] = pv.offset, couple[i] = pv.couple;
   }
   // Per vertex (slot): g_v = Σ_s λ_v g_s, and per vertex pair M_vw = Σ_s λ_v λ_w H_s
   // over the touching samples of their faces; the Jacobians are applied once per vertex pair.

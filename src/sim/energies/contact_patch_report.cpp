@@ -41,6 +41,13 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
           {"patch_minimizations", "", VecX::Constant(1, c.minimizations)}};
   // Where the force acts: the touching samples' mean weighted by their force.
   if (ev.point_weight > 0) out.push_back({"contact_point", "m", ev.point_sum / ev.point_weight});
+  if (anchors_) {
+    VecX points(long(c.anchor_vertices.size()));
+    for (size_t i = 0; i < c.anchor_vertices.size(); ++i) points[long(i)] = c.anchor_vertices[i];
+    out.push_back({"anchor_forces", "N", ev.anchor_forces.size() ? ev.anchor_forces : VecX()});
+    out.push_back({"anchor_points", "", points});
+    out.push_back({"max_stretch", "m", VecX::Constant(1, ev.max_stretch)});
+  }
   return out;
 }
 

@@ -70,11 +70,13 @@
 // Objects: static, kinematic (a world frame of the step inputs) or
 // dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "sflsh/geometry/sdf.hpp"
+#include "sflsh/sim/energies/anchor.hpp"
 #include "sflsh/sim/energy_term.hpp"
 #include "sflsh/sim/material.hpp"
 #include "sflsh/sim/posed_points.hpp"
@@ -117,6 +119,19 @@ struct ContactPatchOptions {
   bool subspace_mean_dilatation = true;  // SoftTissueOptions' default
 };
 
+/// A kinematic grasping tool's anchors (anchor.hpp) held by a patch term:
+/// the anchored skin vertices seed the patch like touching vertices, and
+/// their springs join Φ at the vertices' full position (subspace plus patch):
+///   Σ_p ½ k |x_p − a_p|² + ½ (k_d/h) |(x_p − x_p,t) − (a_p − a_p,t)|²,
+/// x_p = x_p(q) + A_p Σ_c b_pc δu_c. A pinch lifts a tent a few centimetres
+/// wide that the smooth subspace cannot form: on the subspace alone the
+/// springs carry the lift through their stretch, and the tool's force is
+/// several times the full FEM's.
+struct PatchAnchors {
+  std::string set;        ///< the anchor set the step inputs give (EnergyTerm::input_anchor_set)
+  AnchorOptions options;  ///< hardness k (N/m) and damping k_d (N·s/m) per anchor
+};
+
 class ContactPatchTerm : public EnergyTerm {
  public:
   /// `field` in the object's shape frame, placed by the world frame `object`
@@ -125,13 +140,19 @@ class ContactPatchTerm : public EnergyTerm {
   /// inputs, placed by `shape_in_frame`), or, when `dynamic_object`, a rigid
   /// body of the model bound second (its configuration's bone 0 times
   /// `shape_in_frame`; equal and opposite forces, as sdf_contact.hpp).
+  /// With `anchors` (a kinematic object only) the term also holds a grasping
+  /// tool's anchors (PatchAnchors); `field` may then be null (a tool without
+  /// a shape: anchors only).
   ContactPatchTerm(std::string object, const Avatar& avatar, geometry::SdfPtr field, const Isometry& shape_in_frame,
-                   bool dynamic_object, const ContactPatchOptions& options = {});
-  std::string name() const override { return "contact:" + object_; }
-  /// Static or kinematic: the world frame `object`; dynamic: none.
+                   bool dynamic_object, const ContactPatchOptions& options = {},
+                   std::optional<PatchAnchors> anchors = std::nullopt);
+  /// "contact:<object>", or "anchor:<set>" for anchors without a shape.
+  std::string name() const override { return field_ ? "contact:" + object_ : "anchor:" + anchors_->set; }
+  /// Static or kinematic with a shape: the world frame `object`; else none.
   std::vector<std::string> input_frames() const override {
-    return dynamic_ ? std::vector<std::string>{} : std::vector<std::string>{object_};
+    return dynamic_ || !field_ ? std::vector<std::string>{} : std::vector<std::string>{object_};
   }
+  std::string input_anchor_set() const override { return anchors_ ? anchors_->set : ""; }
   bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
   std::unique_ptr<TermCache> make_cache() const override;
   void begin_step(const StepContext& ctx) const override;
@@ -141,6 +162,8 @@ class ContactPatchTerm : public EnergyTerm {
   /// "max_penetration" (m), "contact_area" (m²), "patch_nodes", "patch_radius" (m), "max_patch_displacement" (m),
   /// "patch_displacement" (4 per patch node: the node's index, then its δu, m, unposed),
   /// "contact_point" (3, m: the touching samples' mean weighted by their force; only in contact);
+  /// with anchors also "anchor_forces", "anchor_points" and "max_stretch" as
+  /// AnchorTerm (the vertices at their patched position), their forces in "force";
   /// also fixes the patch displacement of the step (header comment).
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
@@ -167,9 +190,17 @@ class ContactPatchTerm : public EnergyTerm {
   // the patch tets' elasticity less what the subspace's elastic term holds of them (+inf if one inverts),
   double add_patch_elasticity(const StepContext& ctx, const Configuration& q, const VecX& du,
                               const EvaluationMode& mode, Evaluation& out) const;
-  // the contact over the candidate faces' samples.
+  // the contact over the candidate faces' samples,
   double add_patch_contact(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
                            Evaluation& out) const;
+  // the anchors' springs and dampers (contact_patch_anchors.cpp).
+  double add_patch_anchors(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
+                           Evaluation& out) const;
+  /// Reads the step's anchors into the cache; appends the anchored vertices
+  /// to the seeds (their φ: minus the stretch at t, at least 1e-9 deep).
+  void collect_anchors(const StepContext& ctx, TermCache& cache, std::vector<int>& seeds,
+                       std::vector<double>& seed_phi) const;
+
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
   /// What the subspace's elastic term holds of tet `t` per unit volume at F
@@ -178,6 +209,9 @@ class ContactPatchTerm : public EnergyTerm {
   /// (the remainder's weight capped at the tet's own volume).
   double subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
   // begin_step's parts (contact_patch.cpp), each filling the term's cache:
+  /// The skin vertices near the object at t (increasing) and their φ; places the field at t + h.
+  void find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
+                          std::vector<double>& near_phi) const;
   void collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const;
   void prepare_patch_tets(TermCache& cache) const;
   /// The bulk share of Φ_zz the patch tets add (cache's bulk_hessian), kept while they stay the same.
@@ -193,6 +227,7 @@ class ContactPatchTerm : public EnergyTerm {
   Isometry shape_in_frame_;
   bool dynamic_ = false;
   ContactPatchOptions options_;
+  std::optional<PatchAnchors> anchors_;
   PosedPoints vertices_;  // skin vertices (subspace), rows truncated
   PosedPoints nodes_;     // tet nodes (subspace)
   VecX node_mass_;        // lumped, kg
