@@ -164,9 +164,6 @@ void add_object_contacts(ModelBuilder& mb, const std::vector<CompiledBody>& bodi
     for (const CompiledObject& o : objects) {
       if (!sc.collides(b.desc->name, o.desc->name)) continue;
       const bool dynamic = o.model_index >= 0;
-      require(!(c.patch && dynamic), sc.path, ": contact.patch: object '", o.desc->name,
-              "' is dynamic; the contact patch takes static and kinematic objects (a dynamic one: "
-              "remove contact.patch or make it kinematic)");
       terms.push_back(add_shape_contact(mb, b, o.desc->name, o.model.field,
                                         dynamic ? o.model.shape_in_body : Isometry::Identity(), dynamic, o.model_index,
                                         c.patch, c, samples));
@@ -186,9 +183,10 @@ RigidObjectModel tool_shape(const std::string& name, const ShapeDescription& sha
 /// contact with every body through its shape and jaws (with contact.patch a
 /// kinematic tool gets the face-sampled contact, a coupled one keeps the
 /// per-sample penalty); with sensors one anchor term per body for grasping
-/// (with contact.patch and a kinematic tool, the anchors join the patch of
-/// the tool's shape, or get their own: one patch under the tool, whose
-/// displacement the shape and the anchors share).
+/// (with contact.patch, a kinematic tool's anchors join the patch of the
+/// tool's shape, or get their own: one patch under the tool, whose
+/// displacement the shape and the anchors share; a coupled tool's anchors
+/// get a patch of their own).
 /// Records the tool's input ids and the terms that act on it.
 CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vector<CompiledBody>& bodies,
                       const ContactDescription& c, SkinSamples& samples) {
@@ -234,14 +232,21 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
       t.anchor_terms.push_back(index);
       if (d.has_shape) t.contact_terms.push_back(index);
       t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
-    } else if (d.has_shape) {
+    } else if (c.patch && grasps) {
+      // A coupled tool: its anchors in a patch of their own, the tool's body bound second.
+      auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, nullptr, Isometry::Identity(), true,
+                                                           patch_options(c), PatchAnchors{anchor_set, anchor_options});
+      t.anchor_terms.push_back(mb.add_term(term, {b.model_index, t.model_index}));
+      t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
+    }
+    if (!(patch && grasps) && d.has_shape) {
       t.contact_terms.push_back(add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));
     }
     for (const CompiledJaw& jaw : t.jaws)
       t.contact_terms.push_back(add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));
-    if (!grasps || patch) continue;
+    if (!grasps || c.patch) continue;
     auto term = std::make_shared<const AnchorTerm>(anchor_set, PosedPoints::at_surface(*b.avatar), coupled,
                                                    anchor_options);
     t.anchor_terms.push_back(coupled ? mb.add_term(term, {b.model_index, t.model_index})

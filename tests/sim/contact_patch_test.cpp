@@ -324,6 +324,47 @@ TEST(ContactPatch, UnderGravityTheWholeBodyPatchIsStillTheFullSpaceStep) {
   EXPECT_LT(worst, 1e-6 * peak) << "peak " << peak;
 }
 
+TEST(ContactPatch, OutOfContactThePatchDecaysWithItsReleaseTimeAndLeaves) {
+  // The ball dents the slab for 4 steps, then jumps 10 cm away: from the
+  // next step on, δu is prescribed, e^(−h/τ) times the last one (τ = 20 ms),
+  // and the nodes leave once it is below 1 µm; the subspace takes the rest.
+  const Avatar coarse = slab(4);
+  Simulator sim(pressed_model(coarse, true, 1));
+  StepInputs in;
+  in.bodies.resize(1);
+  in.bodies[0].bones = identity_bones();
+  auto patch_quantity = [](const StepReport& r, const std::string& name) {
+    for (const TermQuantityReport& q : r.quantities)
+      if (q.name == name && q.value.size() == 1) return q.value[0];
+    return -1.0;  // the term was inactive: no patch
+  };
+  double last = 0;
+  for (int i = 1; i <= 4; ++i) {
+    in.frames["ball"].pose.translation() = Vec3(0.003, 0.03 + 0.012 - 0.0005 * i, -0.002);
+    last = patch_quantity(sim.step(in), "max_patch_displacement");
+  }
+  ASSERT_GT(last, 1e-4);
+  in.frames["ball"].pose.translation() = Vec3(0.003, 0.15, -0.002);
+  const double decay = std::exp(-(1.0 / 60.0) / ContactPatchOptions().release_time);
+  int released_at = -1;
+  for (int i = 1; i <= 30 && released_at < 0; ++i) {
+    const StepReport r = sim.step(in);
+    const double now = patch_quantity(r, "max_patch_displacement");
+    if (now < 0) {
+      released_at = i;
+      break;
+    }
+    EXPECT_NEAR(now, decay * last, 1e-12 * last) << "step " << i << " after the contact";
+    EXPECT_EQ(patch_quantity(r, "patch_iterations"), 0.0) << "a released patch is not minimized";
+    last = now;
+  }
+  // From ~1e-3 m to 1e-6 m at a factor 0.435 a step: about 9 steps (the node
+  // of the largest δu leaves last), not the 30 allowed.
+  EXPECT_GT(released_at, 5);
+  EXPECT_LT(released_at, 15);
+  EXPECT_TRUE(sim.state().z.allFinite());
+}
+
 TEST(ContactPatch, ThePatchIsTheSimulatedNodesWithinItsRadiusOfTheNearSkin) {
   // A 1.2 cm ball 1 mm into the slab's top, body and ball at rest: the near
   // skin is the vertices within the margin of the ball (φ < margin), and the
@@ -514,6 +555,11 @@ TEST(ContactPatch, BadOptionsAreRefusedNamingTheContact) {
     ContactPatchOptions o;
     o.patch_radius = r;
     test::expect_error([&] { make(o); }, {"contact with 'probe'", "patch radius"});
+  }
+  for (double t : {0.0, -1.0, double(NAN)}) {
+    ContactPatchOptions o;
+    o.release_time = t;
+    test::expect_error([&] { make(o); }, {"contact with 'probe'", "release_time"});
   }
   for (double f : {-1.0, double(NAN)}) {
     ContactPatchOptions o;

@@ -40,7 +40,7 @@
 //     friction: 0.5             # Coulomb μ between skin and rigid objects (>= 0); default 0.5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
-//     patch:                    # contact that dents (static and kinematic objects, tools; needs
+//     patch:                    # contact that dents (rigid objects, kinematic tools; needs
 //                               # friction: 0): a pressure over the skin's faces and a full-space
 //                               # patch under it (sim/energies/contact_patch.hpp), also under a
 //                               # kinematic tool's grasp anchors; `patch: true` takes the
@@ -298,9 +298,10 @@ struct ContactDescription {
   std::vector<std::pair<std::string, std::string>> pairs;
   /// contact.patch: body–object contact sampled over the skin's faces with a
   /// pressure stiffness, and a full-space patch under it
-  /// (sim/energies/contact_patch.hpp), for static and kinematic objects.
-  /// Frictionless: refused with friction > 0; a dynamic object is refused
-  /// when the scene is built. Kinematic tools (and their jaws) get it too,
+  /// (sim/energies/contact_patch.hpp), for static, kinematic and dynamic
+  /// objects (a dynamic one's 6 DoFs join the condensed system).
+  /// Frictionless: refused with friction > 0 (an object resting on a slope
+  /// slides). Kinematic tools (and their jaws) get it too,
   /// their grasp anchors in the patch of the tool's shape (or a patch of
   /// their own: PatchAnchors); coupled tools keep the per-sample penalty and
   /// anchors on the subspace.

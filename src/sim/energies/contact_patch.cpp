@@ -40,7 +40,6 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   const std::string what = "contact with '" + object_ + "'";
   require(field_ != nullptr || anchors_, what, ": no field and no anchors");
   if (anchors_) {
-    require(!dynamic_, what, ": anchors in a patch take a kinematic tool (a dynamic one: AnchorTerm)");
     require(!anchors_->set.empty(), what, ": the anchor set has no name");
     const AnchorOptions& ao = anchors_->options;
     require(ao.hardness > 0 && std::isfinite(ao.hardness), what, ": anchor hardness ", ao.hardness,
@@ -54,6 +53,8 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
   require(std::isfinite(o.margin) && o.margin >= 0, what, ": margin ", o.margin, " m, expected >= 0");
   require(o.max_inner_iterations >= 1 && o.inner_tolerance >= 0 && o.release_displacement >= 0, what,
           ": inner iterations must be >= 1 and the tolerances >= 0");
+  require(std::isfinite(o.release_time) && o.release_time > 0, what, ": release_time ", o.release_time,
+          " s, expected a finite number > 0");
   require(o.max_patch_nodes >= 1, what, ": max_patch_nodes ", o.max_patch_nodes, ", expected >= 1");
   require(std::isfinite(o.patch_radius_per_contact_radius) && o.patch_radius_per_contact_radius >= 0, what,
           ": patch_radius_per_contact_radius ", o.patch_radius_per_contact_radius, ", expected a finite number >= 0");
@@ -415,6 +416,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   if (field_) find_near_vertices(ctx, c, near, near_phi);
   collect_candidate_faces(c, near);
   if (anchors_) collect_anchors(ctx, c, near, near_phi);
+  // No skin near the object and no anchor: the patch is released (header comment).
+  c.releasing = near.empty();
   select_patch_nodes(c, near, near_phi);
   prepare_patch_tets(c);
   prepare_bulk_hessian(c);
@@ -440,6 +443,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     c.du.segment<3>(3 * i) = h->second.du;
     c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev;
   }
+  if (c.releasing) c.du *= std::exp(-ctx.h / options_.release_time);
   c.samples_in_patch.clear();
   c.sample_x_star.clear();
   for (int s = 0; s < int(sample_node_.size()); ++s)
@@ -468,7 +472,7 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   if (grad) *grad += ev.gq;
   if (!hess) return E;
   *hess += ev.Hqq;
-  if (du.size() == 0) return E;
+  if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
   // Schur complement over the rows of the layout the patch touches.
   std::vector<int> rows;
   for (int r = 0; r < ev.Hqp.rows(); ++r)

@@ -26,6 +26,9 @@ void ContactPatchTerm::collect_anchors(const StepContext& ctx, TermCache& cache,
   if (!ctx.anchors) return;
   const Avatar& a = *avatar_;
   const Configuration& qt = ctx.bound.empty() ? ctx.q_prev : *ctx.bound[0].q_prev;
+  if (dynamic_)
+    require(ctx.bound.size() == 2 && ctx.bound[1].q_prev != nullptr, name(),
+            ": a dynamic tool's anchors are bound to the body and the tool");
   // By increasing vertex, one anchor per vertex (the last given), as AnchorTerm.
   const std::vector<AnchorPoint>& given = *ctx.anchors;
   std::vector<int> order(given.size());
@@ -38,7 +41,9 @@ void ContactPatchTerm::collect_anchors(const StepContext& ctx, TermCache& cache,
     require(v >= 0 && v < vertices_.size(), name(), ": anchored point ", v, " out of range (", vertices_.size(),
             " skin vertices)");
     require(ap.position.allFinite() && ap.velocity.allFinite(), name(), ": anchored point ", v, " is not finite");
-    const Vec3 target = ap.position - ctx.frame_origin;  // the step frame
+    // Kinematic tool: its point at t + h; dynamic: at t, kept as the offset in the tool's body frame.
+    const Vec3 position = ap.position - ctx.frame_origin;  // the step frame
+    const Vec3 target = dynamic_ ? Vec3(ctx.bound[1].q_prev->bones[0].inverse() * position) : position;
     // The vertex at t with the patch's world offset at t (its tet's nodes' d_t).
     Vec3 x = vertices_.world_point(v, qt);
     const int t = a.surface_tet[v];
@@ -48,7 +53,7 @@ void ContactPatchTerm::collect_anchors(const StepContext& ctx, TermCache& cache,
     }
     c.anchor_vertices.push_back(v);
     c.anchor_target.push_back(target);
-    c.anchor_a_t.push_back(target - ctx.h * ap.velocity);
+    c.anchor_a_t.push_back(dynamic_ ? position : Vec3(position - ctx.h * ap.velocity));
     c.anchor_x_t.push_back(x);
     seeds.push_back(v);
     seed_phi.push_back(-std::max((x - c.anchor_a_t.back()).norm(), 1e-9));
@@ -65,6 +70,7 @@ double ContactPatchTerm::add_patch_anchors(const StepContext& ctx, const Configu
   const Avatar& a = *avatar_;
   const DofLayout& L = local_layout(ctx);
   const double k = anchors_->options.hardness, kd = anchors_->options.damping / ctx.h, kappa = k + kd;
+  const int ob = object_offset(ctx);  // a dynamic tool's 6 DoFs in the term's system, or −1
   out.anchor_forces = VecX::Zero(3 * long(n));
   MatRef Hqq(out.Hqq);
   Eigen::Matrix<double, 3, Eigen::Dynamic> J;
@@ -73,8 +79,9 @@ double ContactPatchTerm::add_patch_anchors(const StepContext& ctx, const Configu
   for (size_t i = 0; i < n; ++i) {
     const int v = c.anchor_vertices[i];
     const PatchedVertex pv = patched_vertex(a, vertices_, c, v, q, du);
-    const Vec3 r = pv.x - c.anchor_target[i];
-    const Vec3 d = (pv.x - c.anchor_x_t[i]) - (c.anchor_target[i] - c.anchor_a_t[i]);
+    const Vec3 tool = ob >= 0 ? Vec3(ctx.bound[1].q->bones[0] * c.anchor_target[i]) : c.anchor_target[i];
+    const Vec3 r = pv.x - tool;
+    const Vec3 d = (pv.x - c.anchor_x_t[i]) - (tool - c.anchor_a_t[i]);
     E += 0.5 * k * r.squaredNorm() + 0.5 * kd * d.squaredNorm();
     const Vec3 g = k * r + kd * d;  // ∂E/∂x
     out.anchor_forces.segment<3>(3 * long(i)) = -g;
@@ -93,12 +100,26 @@ double ContactPatchTerm::add_patch_anchors(const StepContext& ctx, const Configu
     vertices_.local_jacobian(v, q, L, J, cols);
     const VecX gq = J.transpose() * g;
     for (size_t e = 0; e < cols.size(); ++e) out.gq[cols[e]] += gq[long(e)];
+    // A dynamic tool: ∂a/∂(ω, v) = [−[a]×, I] = J_a, its rows get −J_aᵀ g (equal and opposite).
+    Eigen::Matrix<double, 3, 6> Ja;
+    if (ob >= 0) {
+      Ja << -hat(tool), Mat3::Identity();
+      out.gq.segment<6>(ob) -= Ja.transpose() * g;
+    }
     if (!q_hessian) continue;
     add_point_hessian(vertices_, v, q, L, kappa, Hqq);
     const Eigen::Matrix<double, Eigen::Dynamic, 3> JA = kappa * (J.transpose() * pv.A);
     for (const auto& [pj, bj] : pv.couple) {
       if (pj < 0 || bj == 0.0) continue;
       for (size_t e = 0; e < cols.size(); ++e) out.Hqp.block<1, 3>(cols[e], 3 * pj) += bj * JA.row(long(e));
+      if (ob >= 0) out.Hqp.block<6, 3>(ob, 3 * pj) -= kappa * bj * (Ja.transpose() * pv.A);
+    }
+    if (ob < 0) continue;
+    out.Hqq.block<6, 6>(ob, ob) += kappa * Ja.transpose() * Ja;
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> Hob = -kappa * (Ja.transpose() * J);
+    for (size_t e = 0; e < cols.size(); ++e) {
+      out.Hqq.block<6, 1>(ob, cols[e]) += Hob.col(long(e));
+      out.Hqq.block<1, 6>(cols[e], ob) += Hob.col(long(e)).transpose();
     }
   }
   return E;

@@ -70,6 +70,7 @@ struct PatchCache : TermCache {
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
   std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node
   std::vector<Vec3> sample_x_star;             // their predictions
+  bool releasing = false;                      // no contact: δu prescribed (decaying), not minimized
   VecX du;                                     // last minimizer (3 per patch node)
   VecX du_predicted;                           // the step's first start: 2 δu(t) − δu(t − h)
   int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations

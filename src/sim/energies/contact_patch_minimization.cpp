@@ -23,7 +23,7 @@ bool same_configuration(const Configuration& a, const Configuration& b) {
 
 VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
   PatchCache& c = patch_cache(ctx, name());
-  if (c.du.size() == 0) return c.du;
+  if (c.du.size() == 0 || c.releasing) return c.du;  // released: δu prescribed (begin_step)
   // The integrator evaluates the final configuration several times (trial,
   // report): the minimizer is kept.
   const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();

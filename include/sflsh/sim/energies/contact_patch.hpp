@@ -63,9 +63,17 @@
 // Life of a patch: begin_step selects the candidate faces (a vertex within
 // reach of the object at time t) and the patch nodes (Simulated nodes within
 // patch_radius of a near vertex, plus every node whose δu is still above
-// release_displacement: a patch stays until its dent has relaxed, so it
-// releases without a pop). The displacement at t + h is the minimizer at the
-// step's final q, fixed when the integrator asks for the report.
+// release_displacement). The displacement at t + h is the minimizer at the
+// step's final q, fixed when the integrator asks for the report. When no
+// skin is near the object (and no anchor holds), the patch is released: δu
+// is no longer minimized but prescribed, decaying as exp(−t/release_time)
+// (δu(t + h) = e^(−h/τ) δu(t)), and a node leaves once its δu is below
+// release_displacement. Out of contact the minimizer is not zero (the
+// full space relaxes what the subspace holds of the patch's tets), so a patch
+// kept until its dent relaxes never leaves: a ball that bounced off the
+// belly kept a 196-node patch, 8 Newton iterations on δu a step, for ever.
+// The decay releases it over a few time constants without a pop, and the
+// term costs one evaluation (no inner Newton, no Schur complement) meanwhile.
 //
 // Objects: static, kinematic (a world frame of the step inputs) or
 // dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
@@ -112,6 +120,8 @@ struct ContactPatchOptions {
   /// They end when the Newton decrement −gᵀs (J) is below this share of |Φ|.
   double inner_tolerance = 1e-9;
   double release_displacement = 1e-6;  ///< m: a node leaves the patch once |δu| is below this
+  /// s (> 0): out of contact, δu decays with this time constant (header comment, "Life of a patch").
+  double release_time = 0.02;
   int max_handles = 8;                 ///< basis row truncation of the skin vertices (sdf_contact.hpp)
   /// The body's elastic term averages the volume change per cell
   /// (SoftTissueOptions::mean_dilatation): the patch subtracts what that term
@@ -119,14 +129,17 @@ struct ContactPatchOptions {
   bool subspace_mean_dilatation = true;  // SoftTissueOptions' default
 };
 
-/// A kinematic grasping tool's anchors (anchor.hpp) held by a patch term:
+/// A grasping tool's anchors (anchor.hpp) held by a patch term:
 /// the anchored skin vertices seed the patch like touching vertices, and
 /// their springs join Φ at the vertices' full position (subspace plus patch):
 ///   Σ_p ½ k |x_p − a_p|² + ½ (k_d/h) |(x_p − x_p,t) − (a_p − a_p,t)|²,
 /// x_p = x_p(q) + A_p Σ_c b_pc δu_c. A pinch lifts a tent a few centimetres
 /// wide that the smooth subspace cannot form: on the subspace alone the
 /// springs carry the lift through their stretch, and the tool's force is
-/// several times the full FEM's.
+/// several times the full FEM's. The tool is kinematic or, with the term's
+/// dynamic object, a rigid body bound second; its anchor points come as
+/// AnchorTerm takes them (a_p at t + h, or at t for a dynamic tool: a_p =
+/// G_tool(q) o_p), and the tool gets the opposite force.
 struct PatchAnchors {
   std::string set;        ///< the anchor set the step inputs give (EnergyTerm::input_anchor_set)
   AnchorOptions options;  ///< hardness k (N/m) and damping k_d (N·s/m) per anchor
@@ -140,7 +153,7 @@ class ContactPatchTerm : public EnergyTerm {
   /// inputs, placed by `shape_in_frame`), or, when `dynamic_object`, a rigid
   /// body of the model bound second (its configuration's bone 0 times
   /// `shape_in_frame`; equal and opposite forces, as sdf_contact.hpp).
-  /// With `anchors` (a kinematic object only) the term also holds a grasping
+  /// With `anchors` the term also holds the object's (a tool's) grasping
   /// tool's anchors (PatchAnchors); `field` may then be null (a tool without
   /// a shape: anchors only).
   ContactPatchTerm(std::string object, const Avatar& avatar, geometry::SdfPtr field, const Isometry& shape_in_frame,
