@@ -172,7 +172,7 @@ def judge(work):
         raise BadResults(f"{w('momentum_bump.log')}: 'linear momentum' line: change {m[3]!r} / start {m[1]!r} "
                          "is not a ratio of numbers") from None
     row("two-body collision, gravity off: |Δp| / |p|", "≤ 1e-6", f"{rel:.1e}", rel <= 1e-6, "figures/momentum_bump.yaml")
-    # Pinch-and-lift from a recorded pose file (issue 11).
+    # Pinch-and-lift from a recorded pose file.
     log, path = logs["pinch_from_file"], w("pinch_from_file.log")
     m = search(r"tools: peak force ([\d.]+) N, largest anchor stretch ([\d.]+) mm", log, path,
                "'tools: peak force ... largest anchor stretch ...'")

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 11's teleoperation figures on the built-in avatar.
+"""Teleoperation figures on the built-in avatar.
 
   * pinch-and-lift with a coupled gripper from a recorded pose file
     (apps/scenes/figures/pinch_coupled.yaml): slip, grasp/release, rejected
@@ -287,7 +287,7 @@ def judge(work):
         0 < rejected <= rep["corrupted"] and accepted + rejected == received, "teleop_pinch.yaml")
 
     load = os.getloadavg()
-    text = ["# Teleoperation figures (issue 11)\n",
+    text = ["# Teleoperation figures\n",
             "Built-in avatar (`sflsh precompute --out avatar.h5`), kinematic bones, coupled gripper (stiffness "
             "2e4 N/m, mass 0.1 kg, critical damping), anchors 2e5 N/m unless said.",
             f"Reproduce: `/usr/bin/python3 scripts/teleop_figures.py` (about two minutes after the build; "

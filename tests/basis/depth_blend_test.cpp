@@ -1,4 +1,4 @@
-// The default basis (issue 13): bounded biharmonic weights with free bones,
+// The default basis: bounded biharmonic weights with free bones,
 // normalized to a partition of unity and blended to 0 at the bone by the
 // harmonic depth fraction, so every simulated region's skin moves.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Region-balanced handle placement (issue 13): on a thick torso with two thin
+// Region-balanced handle placement: on a thick torso with two thin
 // limbs, the old bone-seeded farthest-point sampling puts every handle in the
 // torso; the region-balanced one gives each limb handles and soft weight.
 #include <gtest/gtest.h>
@@ -19,7 +19,7 @@
 namespace sflsh::basis {
 namespace {
 
-// The placement before issue 13: one region, distances from the bones counted once.
+// The earlier placement: one region, distances from the bones counted once.
 HandlePlacementOptions old_options() {
   HandlePlacementOptions o;
   o.dirichlet_distance_scale = 1.0;
@@ -114,14 +114,14 @@ TEST(RegionHandlePlacement, OldPlacementLeftTheLimbsWithoutHandles) {
   const HandleSet old = select_handles(b.mesh, b.role, 12, b.thickness, VecXi(), old_options());
   const auto n = handles_per_region(old);
   std::printf("old placement, handles torso/left/right: %d/%d/%d\n", n[0], n[1], n[2]);
-  EXPECT_EQ(n[0], 12);  // the defect of issue 13, reproduced
+  EXPECT_EQ(n[0], 12);  // the defect, reproduced
 }
 
 TEST(RegionHandlePlacement, EveryRegionGetsHandlesAndSoftWeight) {
   const test::LimbedBody b;
   const VecXi node_region = node_regions_from_tets(b.mesh, b.tet_region, 3);
   const int K = 12;
-  // A minimum of 2 per region (the default until session 12; 4 of 12 handles
+  // A minimum of 2 per region (the earlier default; 4 of 12 handles
   // in each of 3 regions would leave the allocation nothing to decide).
   HandlePlacementOptions two;
   two.min_per_region = 2;

@@ -1,4 +1,4 @@
-// The reduced model with a real basis against the full-FEM reference (issue 16: "reduced
+// The reduced model with a real basis against the full-FEM reference ("reduced
 // against full FEM with a real basis"): bounded biharmonic weights as precompute makes them
 // (select_handles, the default DepthBlend QPs) with K = 8, 16, 32 on a box of 2,160 tets whose
 // base is bone, driven by a prescribed skeleton motion (the pelvis bobs ±2 cm at 2 Hz: the

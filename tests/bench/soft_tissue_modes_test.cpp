@@ -1,4 +1,4 @@
-// Vibration modes (issue 13's candidate basis) and the vector-basis projector
+// Vibration modes (a candidate basis) and the vector-basis projector
 // that measures their floor: against a closed-form spring chain, a dense
 // generalized eigensolver, the linear-elastic energy of a uniform strain, and a
 // dense weighted least-squares solve.

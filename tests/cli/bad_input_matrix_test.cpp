@@ -1,4 +1,4 @@
-// The bad-input matrix (issue 16): one data-driven table that runs every CLI
+// The bad-input matrix: one data-driven table that runs every CLI
 // entry point against missing, empty, truncated, wrong-type (a PNG) and
 // directory inputs, NaN in each numeric field or flag, wrong array shapes,
 // unknown joint/region names, out-of-range numbers and unwritable outputs.

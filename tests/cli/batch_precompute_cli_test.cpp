@@ -231,7 +231,7 @@ TEST_F(BatchCli, DaskLocalClusterOfTwoWorkersBuildsEveryRow) {
 /// `--handles-min-per-region`: every region that a minimum of 2 leaves at 2
 /// handles gets at least 3 with the flag at 3, from the same K (taken from the
 /// large regions), and the batch content key tells the settings apart (also
-/// the default, 4, from 2: the default until session 12, whose keys did not
+/// the default, 4, from 2: the earlier default, whose keys did not
 /// spell the minimum out).
 TEST_F(BatchCli, HandlesMinPerRegionRaisesTheSmallRegionsCounts) {
   const std::string coarse = " --cell-size 0.08 --facet-size 0.06 --facet-distance 0.004 --cache-dir " +

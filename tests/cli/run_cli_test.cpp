@@ -1,4 +1,4 @@
-// `sflsh run scene.yaml` (issue 11) end to end on the small box avatar: a run
+// `sflsh run scene.yaml` end to end on the small box avatar: a run
 // that records its tools' device poses and a --replay of that recording write
 // identical result files; --realtime keeps in step with the clock (RTF
 // reported) and runs the same number of steps; the tool log has a row per

@@ -1,4 +1,4 @@
-// `sflsh stress-suite` and the light-bone fix (issue 13 §3): bad input gets
+// `sflsh stress-suite` and the light-bone fix: bad input gets
 // one clear error and no output; a short suite on a small avatar writes its
 // CSV, markdown and plot and skips the CMU cases without data; `shake` at
 // dt = 1/30 on the default body, which damped 1,666 of 10,000 steps before

@@ -1,7 +1,7 @@
 // `sflsh simulate` with dynamic bones warns when the pelvis strays from the
 // motion's root by more than --tracking-tolerance (mm), quoting the same
 // maximum the run reports; --strict makes it an error (exit != 0) after the
-// result is written; within the tolerance nothing is said (issue 13).
+// result is written; within the tolerance nothing is said.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

@@ -1,10 +1,10 @@
 // Golden results of run_simulation, recorded with the single-avatar runtime
-// before the model/state redesign (issue 9): every later change to the
+// before the model/state redesign: every later change to the
 // runtime's structure must reproduce them within 1e-12 (relative). They are
 // fingerprints of the whole trajectory (sums over every output frame of z and
 // of the joints), so a change anywhere in the state shows.
 //
-// The dynamic-bone values were re-recorded once, deliberately, for issue 13
+// The dynamic-bone values were re-recorded once, deliberately, for a change of the physics
 // §3 (joint springs from the carried inertia); the old rule keeps its values.
 // To re-record after an intended change of the physics (never for a refactor):
 //   SFLSH_PRINT_GOLDEN=1 build/test_scene --gtest_filter='GoldenRun.*'
@@ -40,11 +40,11 @@ Fingerprint run(bool bones_dynamic, double damping, int newton_iters,
   o.sim.damping = damping;
   o.sim.newton.iterations = newton_iters;
   // Recorded with every tet's volume change integrated on its own; mean
-  // dilatation (issue 13) is a change of the physics, pinned by
+  // dilatation is a change of the physics, pinned by
   // LinearizedStiffness.* instead.
   o.sim.mean_dilatation = false;
   // Recorded with exactly the planned iterations; the automatic second one
-  // where a step is far off its quadratic model (issue 13, on by default with
+  // where a step is far off its quadratic model (on by default with
   // bones prescribed) is pinned by Newton.* instead.
   o.sim.newton.nonlinearity_tolerance = 0.0;
   o.skeleton.body_mass = 70.0;
@@ -82,7 +82,7 @@ void expect_golden(const char* name, const Fingerprint& f, const Fingerprint& go
   EXPECT_TRUE(near(f.joints_weighted, golden.joints_weighted))
       << name << " joints_weighted " << f.joints_weighted << " vs " << golden.joints_weighted;
   // The energy sum (~1.5e3 J over every step, terms that nearly cancel) moves
-  // by ~3e-11 relative when the Hessian's sums are reassociated (issue 13's
+  // by ~3e-11 relative when the Hessian's sums are reassociated (the
   // exact speed-ups), while z and the joints stay within 1e-12.
   auto near_energy = [](double a, double b) { return std::abs(a - b) <= 1e-10 * std::max(1.0, std::abs(b)); };
   EXPECT_TRUE(near_energy(f.energy_sum, golden.energy_sum)) << name << " energy_sum " << f.energy_sum << " vs "
@@ -93,12 +93,12 @@ void expect_golden(const char* name, const Fingerprint& f, const Fingerprint& go
 const Fingerprint GOLDEN_KINEMATIC{-0.16048986258224809, 0.0013841847608966299, -5.137943325508874,
                                    387.6405775962013,    88454.108197037393,    -209.91253726713617};
 // Dynamic bones with the joint springs sized by Winter's segment rods
-// (SpringInertia::Segments, the only rule until issue 13 §3): still the 3975d9d values.
+// (SpringInertia::Segments, the only rule before the light-bone fix): still the 3975d9d values.
 const Fingerprint GOLDEN_DYNAMIC_DAMPED_SEGMENTS{-0.14573196353602896, 0.0011873577921466564, -4.5362158367848231,
                                                  388.01090021120183,   88900.171457576216,    1623.33422968074};
 const Fingerprint GOLDEN_DYNAMIC_NEWTON3_SEGMENTS{-0.16202234953151898, 0.0014227521474823909, -5.1486857159923707,
                                                   388.07751063240153,   88936.122539460484,    155.42325291076676};
-// Re-recorded for issue 13 §3, an intended change of the physics: the joint
+// Re-recorded once, an intended change of the physics: the joint
 // springs are sized by the inertia each joint carries (flesh of the inertia
 // cubature + skeleton, joint_carried_inertia), the default since then.
 const Fingerprint GOLDEN_DYNAMIC_DAMPED{-0.14519048816603758, 0.0011964422807823395, -4.5093541424355852,

@@ -1,4 +1,4 @@
-// Running scene files (issue 10) on a small synthetic avatar written to a
+// Running scene files on a small synthetic avatar written to a
 // temporary folder: a dynamic ball in free fall follows backward Euler's
 // closed form until it lands and then rests on the body, a kinematic object's
 // poses are its keyframes, several bodies are concatenated in the result, and

@@ -1,4 +1,4 @@
-// SceneSession::reset() and set_stiffness_scale() (issue 15: the viewer's
+// SceneSession::reset() and set_stiffness_scale() (the viewer's
 // reset button and stiffness slider) on the small box avatar: a reset
 // followed by N steps is bit-identical to a fresh session's N steps; the
 // scaled model's elastic energy, gradient and Hessian equal those of an

@@ -1,4 +1,4 @@
-// Tools in a scene session (issue 11) on the small box avatar: a coupled probe
+// Tools in a scene session on the small box avatar: a coupled probe
 // pressed into the flesh is held out by contact while its device goes deeper,
 // and the device feels the coupling spring k (c − d) — equal, at rest, to what
 // the flesh pushes on the tool — scaled by the haptic gain and clamped at

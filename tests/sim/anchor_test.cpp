@@ -1,4 +1,4 @@
-// Anchor term (issue 11): energy against its closed form, gradient against
+// Anchor term: energy against its closed form, gradient against
 // central differences, Gauss–Newton Hessian against (k + c/h) Σ DᵀD with
 // D = ∂(x_p − a_p)/∂δ by finite differences of world points (independent of
 // the term's Jacobian code), for a kinematic tool frame and a dynamic tool

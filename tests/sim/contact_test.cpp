@@ -1,4 +1,4 @@
-// Contact terms (issue 10): SDF contact of skin samples against static and
+// Contact terms: SDF contact of skin samples against static and
 // dynamic rigid objects, bone-capsule contact between bodies. Gradients
 // against finite differences through the embedded-sample chain rule (bones
 // and z), Gauss–Newton Hessians against k Σ j jᵀ with j = ∂d/∂δ by finite

@@ -1,5 +1,5 @@
-// Grasping through proximity sensors and anchors on a small body (issue 11;
-// AMBF Alg. 3): a jaw above the top of the synthetic box closes, its sensor's
+// Grasping through proximity sensors and anchors on a small body
+// (AMBF Alg. 3): a jaw above the top of the synthetic box closes, its sensor's
 // ray hits the skin, the hit face's vertices are anchored with their offsets
 // in the jaw frame; the jaw is lifted 1 cm over 20 steps and held, the
 // anchored points follow it (stretch measured against the jaw offsets); the

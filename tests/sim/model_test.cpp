@@ -1,4 +1,4 @@
-// The runtime's model/state split (issue 9): block layout and groups, the
+// The runtime's model/state split: block layout and groups, the
 // assembler's scatter against an independent dense assembly, several bodies in
 // one model, save/restore of a state, world frames through the pelvis-centred
 // step, inactive terms and the report hook.

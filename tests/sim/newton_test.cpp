@@ -197,9 +197,9 @@ TEST(Simulator, ConvergedNewtonReachesTheMinimizer) {
     const StepReport rep = sim.step(target);
     // Round-off level: the line search stops when E (~0.5 J, resolved to ~1e-16 J)
     // no longer decreases, at |g| ~ 1e-8 here; reassociating the Hessian's sums
-    // (issue 13's exact speed-ups) moves the last iterate by round-off and |g|
+    // (the exact speed-ups) moves the last iterate by round-off and |g|
     // from just below to just above 1e-8, hence the margin. Mean dilatation
-    // (the default since issue 13) couples each cell's tets in K, whose larger
+    // (the default) couples each cell's tets in K, whose larger
     // entries raise that floor to ~1e-7; not converging would leave |g| near
     // its start (~0.8).
     EXPECT_LT(rep.grad_norm_after, 3e-7 * std::max(1.0, rep.grad_norm_before)) << rep.summary();

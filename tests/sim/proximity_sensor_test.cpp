@@ -1,4 +1,4 @@
-// Proximity sensors (issue 11): ray hits against the posed skin of the
+// Proximity sensors: ray hits against the posed skin of the
 // synthetic avatar compared with brute force over every triangle, computed
 // here independently (plane intersection, then inside-test and barycentric
 // coordinates from sub-triangle areas).

@@ -1,4 +1,4 @@
-// The real-time loop (AMBF Eq. 1; issue 11) on a fake clock: the substeps
+// The real-time loop (AMBF Eq. 1) on a fake clock: the substeps
 // advance the clock by their cost, a frame adds a fixed overhead (rendering,
 // I/O). Fast steps: RTF → 1 and N follows the elapsed time; slow steps: N is
 // clamped at N_max, the frame is reported behind and RTF = δt / cost < 1.

@@ -1,4 +1,4 @@
-// The exact speed-ups of the step (issue 13, "Faster") change no result:
+// The exact speed-ups of the step ("Faster") change no result:
 // - the inertia Hessian assembled from J's block structure equals the dense
 //   product Jᵀ M J of the points' full Jacobian (PosedPoints::jacobian);
 // - the elastic Hessian assembled into an upper-triangle scratch equals the

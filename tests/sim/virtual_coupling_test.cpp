@@ -1,4 +1,4 @@
-// Virtual coupling term (issue 11): the energy against its closed form
+// Virtual coupling term: the energy against its closed form
 // computed by hand (½k r² + k_r (1 − cos θ) + the dampers), the gradient
 // against central differences, the Hessian against second differences where
 // it is exact (tool origin at the pivot, rotational damper residual zero) and
