@@ -411,6 +411,52 @@ bodies:
   EXPECT_EQ(tool.body_surface(0), object.body_surface(0));  // the same dent
 }
 
+TEST_F(ToolSession, WithContactPatchAGrippersShapeAndAnchorsShareOnePatch) {
+  // A kinematic sphere tool with a grasp sensor presses 3 mm into the top,
+  // closes and lifts off the skin: with contact.patch its contact and its anchors are
+  // one term on the body (one patch, whose displacement both share), and the
+  // tool feels minus that term's force.
+  const std::string scene = R"(
+solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
+contact: {friction: 0, patch: {radius: 0.015}}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+tools:
+  - name: probe
+    shape: {type: sphere, radius: 0.01}
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.042, 0.0], closure: 0.8}
+      - {time: 0.1, position: [0.0, 0.037, 0.0], closure: 0.8}
+      - {time: 0.15, position: [0.0, 0.037, 0.0], closure: 0.0}
+      - {time: 0.3, position: [0.0, 0.043, 0.0], closure: 0.0}
+    grasp:
+      sensors: [{origin: [0, 0, 0], direction: [0, -1, 0], range: 0.03}]
+      hardness: 2.0e3
+)";
+  SceneSession s(read_scene_description(write_scene(scene)), quiet());
+  int terms = 0;
+  for (const Model::BoundTerm& t : s.simulator().model().terms())
+    if (t.term->name() == "contact:probe" || t.term->name().rfind("anchor:", 0) == 0) ++terms;
+  EXPECT_EQ(terms, 1) << "one term for the tool's shape and anchors";
+  EXPECT_EQ(s.compiled_tool(0).anchor_terms, s.compiled_tool(0).contact_terms);
+  double anchors = 0, nodes = 0;
+  for (int k = 0; k < 30; ++k) {
+    const StepReport& rep = s.advance();
+    Vec3 force = Vec3::Zero();
+    for (const TermQuantityReport& q : rep.quantities) {
+      if (q.term != "contact:probe") continue;
+      if (q.name == "force") force = Vec3(q.value[0], q.value[1], q.value[2]);
+      if (q.name == "anchor_points") anchors = std::max(anchors, double(q.value.size()));
+      if (q.name == "patch_nodes") nodes = std::max(nodes, q.value[0]);
+    }
+    EXPECT_EQ(s.tool_state(0).force, -force) << "step " << k;
+  }
+  EXPECT_GT(anchors, 0) << "the tool grasped";
+  EXPECT_GT(nodes, 0);
+  EXPECT_GT(s.tool_state(0).anchors, 0);
+  EXPECT_LT(s.tool_state(0).force.y(), -0.01) << "lifted off, the anchored skin pulls the tool down: " << s.tool_state(0).force.transpose();
+}
+
 TEST_F(ToolSession, TheResultFileHoldsEveryToolsFramesAndItsGraspEvents) {
   // A gripper closing 2 mm above the top grasps the skin; its frames in the
   // result (pose, closure, force, torque) are what the session reported at
