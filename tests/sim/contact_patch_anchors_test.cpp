@@ -41,6 +41,20 @@ std::vector<int> pinched_vertices(const Avatar& a) {
   return out;
 }
 
+/// A step of the slab from rest (h = 1/60 s, no gravity).
+StepContext at_rest(const Avatar& a, bool bones_dynamic) {
+  StepContext ctx;
+  ctx.avatar = &a;
+  ctx.layout.num_reduced = a.num_reduced();
+  ctx.layout.bones_dynamic = bones_dynamic;
+  ctx.h = 1.0 / 60.0;
+  ctx.gravity = Vec3::Zero();
+  ctx.q_prev.bones = identity_bones();
+  ctx.q_prev.z = VecX::Zero(a.num_reduced());
+  ctx.q_prev2 = ctx.q_prev;
+  return ctx;
+}
+
 constexpr double kHardness = 2.0e3, kDamping = 0.5;
 
 /// The slab's soft tissue and a tool "tool" holding its anchors: an AnchorTerm
@@ -170,15 +184,7 @@ TEST(PatchAnchors, CondensedEnergyGradientMatchesFiniteDifferences) {
   }
   for (bool dynamic : {false, true}) {
     SCOPED_TRACE(dynamic ? "bones dynamic" : "bones kinematic");
-    StepContext ctx;
-    ctx.avatar = &a;
-    ctx.layout.num_reduced = a.num_reduced();
-    ctx.layout.bones_dynamic = dynamic;
-    ctx.h = 1.0 / 60.0;
-    ctx.gravity = Vec3::Zero();
-    ctx.q_prev.bones = identity_bones();
-    ctx.q_prev.z = VecX::Zero(a.num_reduced());
-    ctx.q_prev2 = ctx.q_prev;
+    StepContext ctx = at_rest(a, dynamic);
     ctx.anchors = &anchors;
     Configuration q = ctx.q_prev;
     for (int i = 0; i < q.z.size(); ++i) q.z[i] = 5e-4 * std::sin(1.7 * i + 0.3);
@@ -232,15 +238,7 @@ TEST(PatchAnchors, ADynamicToolGetsTheOppositeForceAndItsDerivativesMatchFiniteD
   EXPECT_EQ(term.name(), "anchor:tool");
   for (bool dynamic_bones : {false, true}) {
     SCOPED_TRACE(dynamic_bones ? "bones dynamic" : "bones kinematic");
-    StepContext ctx;
-    ctx.avatar = &a;
-    ctx.layout.num_reduced = a.num_reduced();
-    ctx.layout.bones_dynamic = dynamic_bones;
-    ctx.h = 1.0 / 60.0;
-    ctx.gravity = Vec3::Zero();
-    ctx.q_prev.bones = identity_bones();
-    ctx.q_prev.z = VecX::Zero(a.num_reduced());
-    ctx.q_prev2 = ctx.q_prev;
+    StepContext ctx = at_rest(a, dynamic_bones);
     // The tool at t 1 cm above the top, turned a little; at the iterate moved up 2 mm and turned on.
     Configuration tool_prev, tool;
     tool_prev.bones = {Isometry::Identity()};
@@ -316,12 +314,7 @@ TEST(PatchAnchors, BadOptionsAreRefusedNamingTheContact) {
       {"contact with 'tool'", "anchor damping"});
   // An anchored vertex out of range names the term.
   const ContactPatchTerm term("tool", a, nullptr, Isometry::Identity(), false, {}, PatchAnchors{"tool", {}});
-  StepContext ctx;
-  ctx.avatar = &a;
-  ctx.layout.num_reduced = a.num_reduced();
-  ctx.q_prev.bones = identity_bones();
-  ctx.q_prev.z = VecX::Zero(a.num_reduced());
-  ctx.q_prev2 = ctx.q_prev;
+  StepContext ctx = at_rest(a, false);
   std::vector<AnchorPoint> anchors(1);
   anchors[0].point = int(a.surface_rest.rows());
   ctx.anchors = &anchors;

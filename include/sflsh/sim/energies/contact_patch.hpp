@@ -110,8 +110,10 @@ struct ContactPatchOptions {
   /// fixed patch_radius. A 16 cm sphere pressed 3 cm into the belly (a ≈ 6 cm)
   /// gets 45 % too much force with a 4 cm patch, within 1 % with 8 cm.
   double patch_radius_per_contact_radius = 1.5;
-  /// Nodes in one patch at most (its system is dense: cost ~ nodes³): beyond,
-  /// the nodes nearest the deepest contact are kept (a broad press).
+  /// Nodes selected around the contact at most (its system is dense: cost ~
+  /// nodes³): beyond, the nodes nearest the deepest contact are kept (a broad
+  /// press). Nodes still displaced from earlier steps stay on top of these
+  /// until released (a moving contact's patch can hold more).
   int max_patch_nodes = 120;
   /// m: a skin vertex is near the object when φ at time t is below this plus
   /// its motion and the object's over the step.
