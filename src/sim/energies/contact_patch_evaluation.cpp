@@ -277,6 +277,9 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   return E;
 }
 
+// Longer than the usual 120 lines: the sample loop and the chain rule that
+// follows it share the per-vertex accumulators (g_v, M_vw, N_v, the vertices'
+// couplings and rotations); split, they would travel as a handful of arguments.
 double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configuration& q, const VecX& du,
                                            const EvaluationMode& mode, Evaluation& out) const {
   const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;

@@ -1,0 +1,106 @@
+// The patch term's broad phase (contact_patch.hpp, "Life of a patch"): the
+// skin vertices near the object at time t, and the candidate faces around them.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/Geometry>
+
+#include "sflsh/core/error.hpp"
+#include "sim/energies/contact_patch_cache.hpp"
+
+namespace sflsh {
+
+using contact_patch_detail::PatchCache;
+
+/// The skin vertices near the object at time t (by increasing index) and
+/// their φ; also places the field at t + h (cache's field_pose).
+void ContactPatchTerm::find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
+                                          std::vector<double>& near_phi) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const geometry::Aabb local = field_->bounds();
+  const bool bounded = !local.is_unbounded();
+  const double extent = bounded ? 0.5 * (local.max - local.min).norm() : 1.0;
+  double object_motion = 0;
+  if (dynamic_) {
+    // The object's pose at t (the broad phase's reference) and its motion over the last step, doubled.
+    require(ctx.bound.size() == 2 && ctx.bound[1].q_prev != nullptr, name(),
+            ": a dynamic object's contact is bound to the body and the object");
+    const Isometry& G = ctx.bound[1].q_prev->bones[0];
+    c.field_pose = G * shape_in_frame_;
+    if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
+      const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];
+      const double angle = Eigen::AngleAxisd(G.linear() * Gp.linear().transpose()).angle();
+      object_motion = 2 * ((G.translation() - Gp.translation()).norm() + angle * extent);
+    }
+  } else {
+    require(ctx.frame() != nullptr, name(), ": the step inputs have no world frame '", object_, "'");
+    const WorldFrame& f = *ctx.frame();
+    require(f.pose.matrix().allFinite(), name(), ": world frame '", object_, "' is not finite");
+    c.field_pose = f.pose * shape_in_frame_;
+    object_motion = ctx.h * (f.linear_velocity.norm() + f.angular_velocity.norm() * extent);
+  }
+  const Isometry T_inv = c.field_pose.inverse();
+  const geometry::Aabb box = bounded ? local.transformed(c.field_pose) : local;
+
+  // Skin vertices near the object at time t.
+  const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
+                                         : ctx.bound[0];
+  const Configuration& qt = *b.q_prev;
+  const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
+  for (const VertexCluster& cl : clusters_) {
+    // A cluster whose centre, carried by its bone, is farther from the object
+    // than its radius (slack included) plus the reach holds no near vertex.
+    const Vec3 xc = qt.bones[cl.bone] * cl.center;
+    const double motion_c = has_prev ? 2 * (xc - b.q_prev2->bones[cl.bone] * cl.center).norm() : 0.0;
+    if (field_->distance(T_inv * xc) > cl.radius + options_.margin + motion_c + object_motion) continue;
+    for (int v : cl.vertices) {
+      const Vec3 x = vertices_.world_point(v, qt);
+      const double motion = has_prev ? 2 * (x - vertices_.world_point(v, *b.q_prev2)).norm() : 0.0;
+      const double reach = options_.margin + motion + object_motion;
+      if (bounded) {
+        const Vec3 lo = box.min.array() - reach, hi = box.max.array() + reach;
+        if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+      }
+      const double phi = field_->distance(T_inv * x);
+      if (phi < reach) near.push_back(v), near_phi.push_back(phi);
+    }
+  }
+  std::vector<size_t> order(near.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) { return near[i] < near[j]; });
+  {
+    std::vector<int> n2;
+    std::vector<double> p2;
+    for (size_t i : order) n2.push_back(near[i]), p2.push_back(near_phi[i]);
+    near.swap(n2);
+    near_phi.swap(p2);
+  }
+}
+
+/// The candidate faces (every skin face of a near vertex), their samples and
+/// their distinct vertices.
+void ContactPatchTerm::collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  std::vector<char> face_mark(a.surface_faces.rows(), 0);
+  c.faces.clear();
+  for (int v : near)
+    for (int fc : vertex_faces_[v])
+      if (!face_mark[fc]) face_mark[fc] = 1, c.faces.push_back(fc);
+  std::sort(c.faces.begin(), c.faces.end());
+  c.samples.clear();
+  c.face_first.assign(1, 0);
+  c.vertices.clear();
+  c.vertex_slot.clear();
+  for (int fc : c.faces) {
+    append_face_samples(a.surface_rest, a.surface_faces, fc, options_.spacing, c.samples);
+    c.face_first.push_back(int(c.samples.size()));
+    for (int i = 0; i < 3; ++i) {
+      const int v = a.surface_faces(fc, i);
+      if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
+    }
+  }
+}
+
+}  // namespace sflsh
