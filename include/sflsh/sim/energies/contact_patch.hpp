@@ -77,6 +77,12 @@
 //
 // Objects: static, kinematic (a world frame of the step inputs) or
 // dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
+//
+// One patch per term: the patches of two terms (two objects, a gripper's
+// jaws and its anchors) do not merge. Where they overlap, each holds its own
+// δu and each adds the exact energy of the shared tets less the subspace's:
+// the tissue there counts about twice (too stiff, not unstable). A tool's
+// shape and anchors share one term, hence one patch.
 #include <memory>
 #include <optional>
 #include <string>
