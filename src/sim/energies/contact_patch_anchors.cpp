@@ -17,7 +17,6 @@ using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
 using contact_patch_detail::patched_vertex;
 using contact_patch_detail::PatchedVertex;
-using contact_patch_detail::PatchHistory;
 
 void ContactPatchTerm::collect_anchors(const StepContext& ctx, TermCache& cache, std::vector<int>& seeds,
                                        std::vector<double>& seed_phi) const {
