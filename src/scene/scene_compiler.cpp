@@ -223,26 +223,21 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
     const std::string anchor_set = d.name + "@" + b.desc->name;
     const AnchorOptions anchor_options{d.hardness, d.damping};
     const bool grasps = !d.sensors.empty();
-    if (patch && grasps) {
-      // One patch under the tool: its shape's contact (if any) and its anchors.
-      auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, d.has_shape ? t.shape.field : nullptr,
-                                                           Isometry::Identity(), false, patch_options(c),
+    // The shape shares the anchors' patch: a kinematic tool's, with contact.patch and a grasp.
+    const bool shape_in_patch = patch && grasps && d.has_shape;
+    if (c.patch && grasps) {
+      // The anchors' patch (a coupled tool's body bound second).
+      auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, shape_in_patch ? t.shape.field : nullptr,
+                                                           Isometry::Identity(), coupled, patch_options(c),
                                                            PatchAnchors{anchor_set, anchor_options});
-      const int index = mb.add_term(term, {b.model_index});
+      const int index = coupled ? mb.add_term(term, {b.model_index, t.model_index}) : mb.add_term(term, {b.model_index});
       t.anchor_terms.push_back(index);
-      if (d.has_shape) t.contact_terms.push_back(index);
-      t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
-    } else if (c.patch && grasps) {
-      // A coupled tool: its anchors in a patch of their own, the tool's body bound second.
-      auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, nullptr, Isometry::Identity(), true,
-                                                           patch_options(c), PatchAnchors{anchor_set, anchor_options});
-      t.anchor_terms.push_back(mb.add_term(term, {b.model_index, t.model_index}));
+      if (shape_in_patch) t.contact_terms.push_back(index);
       t.anchor_sets.push_back(mb.add_anchor_set(anchor_set));
     }
-    if (!(patch && grasps) && d.has_shape) {
+    if (d.has_shape && !shape_in_patch)
       t.contact_terms.push_back(add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));
-    }
     for (const CompiledJaw& jaw : t.jaws)
       t.contact_terms.push_back(add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled,
                                                   t.model_index, patch, c, samples));

@@ -44,7 +44,7 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
   if (anchors_) {
     VecX points(long(c.anchor_vertices.size()));
     for (size_t i = 0; i < c.anchor_vertices.size(); ++i) points[long(i)] = c.anchor_vertices[i];
-    out.push_back({"anchor_forces", "N", ev.anchor_forces.size() ? ev.anchor_forces : VecX()});
+    out.push_back({"anchor_forces", "N", ev.anchor_forces});
     out.push_back({"anchor_points", "", points});
     out.push_back({"max_stretch", "m", VecX::Constant(1, ev.max_stretch)});
   }
