@@ -1,7 +1,8 @@
 // A grasping tool's anchors held by the contact patch (contact_patch.hpp,
 // PatchAnchors): the patch's limit (covering the whole body, a coarse
 // subspace plus the patch pinches as the nodal full space with AnchorTerm),
-// the condensed gradient against finite differences (a kinematic and a
+// the force without a patch by hand (hardness and damping apart, a kinematic
+// and a dynamic tool), the condensed gradient against finite differences (a kinematic and a
 // dynamic tool), and bad options.
 #include <gtest/gtest.h>
 
@@ -53,6 +54,15 @@ StepContext at_rest(const Avatar& a, bool bones_dynamic) {
   ctx.q_prev.z = VecX::Zero(a.num_reduced());
   ctx.q_prev2 = ctx.q_prev;
   return ctx;
+}
+
+/// A 1.5 cm patch converged tightly, over a subspace without mean dilatation.
+ContactPatchOptions small_patch() {
+  ContactPatchOptions o;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-14;
+  o.subspace_mean_dilatation = false;
+  return o;
 }
 
 constexpr double kHardness = 2.0e3, kDamping = 0.5;
@@ -165,10 +175,7 @@ TEST(PatchAnchors, CoveringTheWholeBodyAPinchIsTheFullSpacePinch) {
 TEST(PatchAnchors, CondensedEnergyGradientMatchesFiniteDifferences) {
   const Avatar a = slab(6);
   const std::vector<int> pinched = pinched_vertices(a);
-  ContactPatchOptions o;
-  o.patch_radius = 0.015;
-  o.inner_tolerance = 1e-14;
-  o.subspace_mean_dilatation = false;
+  const ContactPatchOptions o = small_patch();
   const ContactPatchTerm term("tool", a, nullptr, Isometry::Identity(), false, o,
                               PatchAnchors{"tool", {kHardness, kDamping}});
   EXPECT_EQ(term.name(), "anchor:tool");
@@ -229,10 +236,7 @@ TEST(PatchAnchors, ADynamicToolGetsTheOppositeForceAndItsDerivativesMatchFiniteD
   // is [body | tool (6)]; the anchors' tool points ride on the tool's pose.
   const Avatar a = slab(6);
   const std::vector<int> pinched = pinched_vertices(a);
-  ContactPatchOptions o;
-  o.patch_radius = 0.015;
-  o.inner_tolerance = 1e-14;
-  o.subspace_mean_dilatation = false;
+  const ContactPatchOptions o = small_patch();
   const ContactPatchTerm term("tool", a, nullptr, Isometry::Identity(), true, o,
                               PatchAnchors{"tool", {kHardness, kDamping}});
   EXPECT_EQ(term.name(), "anchor:tool");
@@ -298,6 +302,62 @@ TEST(PatchAnchors, ADynamicToolGetsTheOppositeForceAndItsDerivativesMatchFiniteD
       if (t.name == "force") f = Vec3(t.value[0], t.value[1], t.value[2]);
     ASSERT_GT(f.y(), 0.1);  // the tool pulls the skin up
     EXPECT_LT((g.segment<3>(n - 3) - f).norm(), 1e-6 * f.norm());
+  }
+}
+
+TEST(PatchAnchors, WithoutAPatchEachAnchorPullsByItsHardnessAndDampingByHand) {
+  // The slab at rest, no patch (contact.patch's subspace-only mode): each
+  // tool point is e off its vertex at t and moves by d over the step, so the
+  // anchor is stretched by −(e + d) and slips by −d, and the flesh gets
+  // n (k (e + d) + (c/h) d), whether the tool is kinematic (points given at
+  // t + h with their velocity) or dynamic (points at t, carried by the tool's
+  // pose: translated by d).
+  const Avatar a = slab(6);
+  const std::vector<int> pinched = pinched_vertices(a);
+  ContactPatchOptions o = small_patch();
+  o.patch = false;
+  const Vec3 d(0.0004, 0.0015, -0.0002), e(0.0, 0.001, 0.0003);
+  const double h = 1.0 / 60.0;
+  const Vec3 expected = double(pinched.size()) * (kHardness * (e + d) + kDamping / h * d);
+  for (bool dynamic_tool : {false, true}) {
+    SCOPED_TRACE(dynamic_tool ? "dynamic tool" : "kinematic tool");
+    const ContactPatchTerm term("tool", a, nullptr, Isometry::Identity(), dynamic_tool, o,
+                                PatchAnchors{"tool", {kHardness, kDamping}});
+    StepContext ctx = at_rest(a, false);
+    std::vector<AnchorPoint> anchors;
+    for (int v : pinched) {
+      AnchorPoint p;
+      p.point = v;
+      p.position = a.surface_rest.row(v).transpose() + e + (dynamic_tool ? Vec3::Zero() : d);
+      p.velocity = dynamic_tool ? Vec3::Zero() : Vec3(d / h);
+      anchors.push_back(p);
+    }
+    ctx.anchors = &anchors;
+    // The dynamic tool's body: away from the skin and turned at t (its anchor
+    // offsets are then far from the points), moved by d at the iterate.
+    Configuration tool_prev, tool;
+    tool_prev.bones = {Isometry::Identity()};
+    tool_prev.bones[0].translate(Vec3(0.01, 0.05, 0.02)).rotate(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized()));
+    tool_prev.z = VecX();
+    tool = tool_prev;
+    tool.bones[0].pretranslate(d);
+    DofLayout tool_layout;
+    tool_layout.num_bones = 1;
+    tool_layout.base = ctx.layout.size();
+    Configuration q = ctx.q_prev;
+    if (dynamic_tool)
+      ctx.bound = {{0, 0, &a, ctx.layout, &q, &ctx.q_prev, &ctx.q_prev2},
+                   {1, 1, nullptr, tool_layout, &tool, &tool_prev, &tool_prev}};
+    const auto cache = begin_term_step(term, ctx);
+    ASSERT_TRUE(term.patch_nodes(ctx).empty());
+    Vec3 force = Vec3::Zero();
+    double stretch = 0;
+    for (const TermQuantity& t : term.report(ctx, q)) {
+      if (t.name == "force") force = Vec3(t.value[0], t.value[1], t.value[2]);
+      if (t.name == "max_stretch") stretch = t.value[0];
+    }
+    EXPECT_LT((force - expected).norm(), 1e-9 * expected.norm()) << force.transpose() << " vs " << expected.transpose();
+    EXPECT_NEAR(stretch, (e + d).norm(), 1e-12);
   }
 }
 
