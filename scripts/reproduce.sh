@@ -40,7 +40,7 @@ while [ $# -gt 0 ]; do
 done
 
 # Steps: name | what it writes into OUT | in --quick.
-STEPS_FULL="avatar bench contact hertz stress stress_suite throughput contact_figures teleop fit mocap batch batch_resume shapes readme"
+STEPS_FULL="avatar bench contact hertz stress stress_suite throughput contact_figures teleop fit fit_dynamic mocap batch batch_resume shapes readme"
 STEPS_QUICK="avatar bench stress stress_suite throughput batch_resume"
 describe() {
   case $1 in
@@ -54,6 +54,7 @@ describe() {
     contact_figures) echo "contact_figures.md: scripts/contact_figures.py" ;;
     teleop) echo "teleop.md: scripts/teleop_figures.py" ;;
     fit) echo "fit.md fit_*.svg: scripts/fit_benchmark.py (writes scripts/results/ itself: full run only)" ;;
+    fit_dynamic) echo "fit_dynamic_bones.md: scripts/fit_dynamic_bones.py, fitting a run with dynamic bones" ;;
     mocap) echo "mocap_check.csv pelvis_error.svg: scripts/mocap_check.sh" ;;
     batch) echo "batch_benchmark.md .csv, batch_manifest_*.csv: scripts/batch_benchmark.py" ;;
     batch_resume) echo "batch_resume_check.md: scripts/batch_resume_check.sh" ;;
@@ -237,6 +238,10 @@ for step in $STEPS; do
     run "$PY" scripts/fit_benchmark.py --work "$WORK/fit"
     cp -f "$OUT/fit.md" "$WORK/fit.md" 2>/dev/null && stamp "$WORK/fit.md" "$OUT/fit.md"
     for f in "$OUT"/fit_*.svg; do [ -f "$f" ] && cp -f "$f" "$WORK/$(basename "$f")" && stamp "$WORK/$(basename "$f")" "$f"; done ;;
+  fit_dynamic)
+    d="$WORK/fit_dynamic"; mkdir -p "$d"; [ -f "$AVATAR" ] && cp -f "$AVATAR" "$d/avatar.h5"
+    RUN_STDOUT="$WORK/fit_dynamic_bones.md" run "$PY" scripts/fit_dynamic_bones.py "$d"
+    stamp "$WORK/fit_dynamic_bones.md" "$OUT/fit_dynamic_bones.md" ;;
   mocap)
     need_avatar || continue
     d="$WORK/mocap"; rm -rf "$d"

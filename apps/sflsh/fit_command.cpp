@@ -51,13 +51,15 @@ void run_reference(const FitArgs& a) {
 }
 
 /// One subject: the avatar (with --material), its observations (with --noise),
-/// the steps they fall on and the bones of the motion that drove them.
+/// the steps they fall on and the bones to prescribe: the observed run's own when
+/// the file holds them (a run with dynamic bones), else those of its motion.
 struct LoadedSubject {
   std::shared_ptr<Avatar> avatar;
   Observations obs;
   std::vector<int> steps;
   BoneSequence bones;
   std::string motion;
+  std::string bones_source;  ///< where `bones` come from, for the log
 };
 
 LoadedSubject load_subject(const FitArgs& a, const std::string& avatar_path, const std::string& observed,
@@ -67,18 +69,26 @@ LoadedSubject load_subject(const FitArgs& a, const std::string& avatar_path, con
   if (!a.material.empty()) apply_material_file(a.material, s.avatar->materials);
   s.obs = read_observations(observed, a.fps);
   check_observation_vertices(s.obs, int(s.avatar->surface_rest.rows()), avatar_path);
-  if (s.obs.bones == "dynamic")
-    std::cerr << "sflsh: warning: " << observed
-              << " was simulated with dynamic bones; fit simulates kinematic bones (the motion's, prescribed)\n";
   const double h = !a.dt.empty() ? parse_time_step(a.dt) : (s.obs.dt > 0 ? s.obs.dt : 1.0 / 60.0);
   s.steps = observation_steps(s.obs, h);
   s.motion = !motion_arg.empty() ? motion_arg : s.obs.motion;
-  require(!s.motion.empty(), observed, ": the file names no motion (/meta/motion); give --motion");
-  MotionOptions mo;
-  mo.rest_joints = s.avatar->joints_rest;
-  mo.builtin_seconds = std::max(s.steps.back() * h, h);
-  const MotionClip motion = load_motion(s.motion, mo);
-  s.bones = motion_bones(*s.avatar, motion, h, s.steps.back(), a.start_at_rest);
+  if (!s.obs.step_bones.empty()) {
+    // The run's own bones (dynamic ones are not the motion's): the fit prescribes what the run did.
+    s.bones = observed_bones(s.obs, h, s.steps.back());
+    s.bones_source = "the observed run's own (/steps/bones of a run with " + s.obs.bones + " bones)" +
+                     (a.start_at_rest ? "; --start-at-rest is not used (the file holds the run's start)" : "");
+  } else {
+    if (s.obs.bones == "dynamic")
+      std::cerr << "sflsh: warning: " << observed << " was simulated with dynamic bones but holds no /steps/bones; "
+                << "fit prescribes the motion's bones\n";
+    require(!s.motion.empty(), observed, ": the file names no motion (/meta/motion); give --motion");
+    MotionOptions mo;
+    mo.rest_joints = s.avatar->joints_rest;
+    mo.builtin_seconds = std::max(s.steps.back() * h, h);
+    const MotionClip motion = load_motion(s.motion, mo);
+    s.bones = motion_bones(*s.avatar, motion, h, s.steps.back(), a.start_at_rest);
+    s.bones_source = "the motion's, prescribed";
+  }
   if (a.noise > 0) add_gaussian_noise(s.obs, a.noise, seed);
   return s;
 }
@@ -165,7 +175,7 @@ void run_fit(const FitArgs& a) {
             << " regions) to " << obs.time.size() << " frames of " << a.observed << " (motion " << motion_spec << ", "
             << steps.back() << " steps of " << h * 1e3 << " ms; residuals on every " << a.vertex_stride
             << ". vertex and every " << a.frame_stride << ". frame; " << (a.numeric ? "numeric" : "analytic")
-            << " Jacobians; loss " << a.loss << ")\n";
+            << " Jacobians; loss " << a.loss << ")\nbones: " << sub.bones_source << "\n";
   const MaterialFitResult r = fit_materials(avatar, params, bones, steps, obs.positions, o);
   std::cout << r.brief_report << "\n" << "Ceres stopped: " << r.termination << "\n" << r.describe();
 
@@ -193,8 +203,10 @@ const CommandRegistrar reg(75, [](CLI::App& app) {
   cmd->add_option("--avatar", a->avatar, "Avatar file from `sflsh precompute`");
   cmd->add_option("--observed", a->observed,
                   "Observed skin: a result-layout HDF5 file (/frames/time, /frames/positions in the avatar's surface "
-                  "vertex order) or a .pc2");
-  cmd->add_option("--motion", a->motion, "Motion that drove the observations (default: the file's /meta/motion)");
+                  "vertex order; its run's bones, /steps/bones, are prescribed when it has them) or a .pc2");
+  cmd->add_option("--motion", a->motion,
+                  "Motion that drove the observations, whose bones are prescribed when the file holds none of its "
+                  "run's (default: the file's /meta/motion)");
   cmd->add_option("--params", a->params, "Comma-separated: young, fung_c, poisson, damping")->capture_default_str();
   cmd->add_option("--regions", a->regions, "'all' or comma-separated region names")->capture_default_str();
   cmd->add_option("--out", a->out, "Fitted material file (YAML, as `sflsh simulate --material` reads)");

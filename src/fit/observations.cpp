@@ -9,8 +9,21 @@
 #include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/io/crash_isolation.hpp"
 #include "sflsh/io/point_cache.hpp"
+#include "sflsh/scene/result_file.hpp"
 
 namespace sflsh {
+
+/// /meta/start_bones (2, 24, 7) and /steps/bones (S, 24, 7) of a one-body result (result_file.hpp), when present.
+static void read_run_bones(const io::Hdf5File& f, const std::string& path, Observations& obs) {
+  if (!f.has("/steps/bones") && !f.has("/meta/start_bones")) return;
+  require(f.has("/steps/bones") && f.has("/meta/start_bones"), path,
+          ": has only one of /steps/bones and /meta/start_bones (the run's bones need both)");
+  const std::vector<std::int64_t> shape = f.shape("/steps/bones");
+  require(shape.size() == 3 && shape[2] == 7, path, ": /steps/bones must be (steps, bones, 7)");
+  if (shape[1] != 24) return;  // several bodies: not one avatar's observations (the vertex count check says so)
+  obs.start_bones = read_result_poses(f, path, "/meta/start_bones", 2, 24);
+  obs.step_bones = read_result_poses(f, path, "/steps/bones", shape[0], 24);
+}
 
 static Observations read_observations_in_this_process(const std::string& path, double pc2_fps) {
   require(std::filesystem::exists(path), path, ": observed file not found");
@@ -56,6 +69,7 @@ static Observations read_observations_in_this_process(const std::string& path, d
     if (f.has("/meta/motion")) obs.motion = f.read_string("/meta/motion");
     if (f.has("/meta/dt")) obs.dt = f.read_scalar("/meta/dt");
     if (f.has("/meta/bones")) obs.bones = f.read_string("/meta/bones");
+    read_run_bones(f, path, obs);
   }
   require(!obs.time.empty(), path, ": no frames");
   for (size_t i = 0; i < obs.time.size(); ++i) {

@@ -73,6 +73,7 @@ void pose_to_row(const Isometry& T, double* out, const std::string& what) {
 }
 
 Isometry pose_from_row(const double* in, const std::string& what) {
+  require(std::all_of(in, in + 7, [](double v) { return std::isfinite(v); }), what, ": the pose is not finite");
   Eigen::Quaterniond q(in[3], in[4], in[5], in[6]);
   require(std::abs(q.norm() - 1.0) < kUnitTolerance, what, ": quaternion (w x y z) has norm ", q.norm(),
           ", expected a unit quaternion");
@@ -254,6 +255,27 @@ void ResultWriter::write_tool_events(const std::vector<ToolEvent>& events) {
   file_->write_strings("/tool_events/kind", kind);
 }
 
+void ResultWriter::write_bones(const SimulationResult& r) {
+  if (r.step_bones.empty() && r.start_bones.empty()) return;
+  const std::string& path = file_->path();
+  const std::int64_t S = r.step_time.size(), J = num_joints_;
+  require(std::int64_t(r.step_bones.size()) == S && r.start_bones.size() == 2, path, ": ", r.step_bones.size(),
+          " steps of bones for ", S, " steps and ", r.start_bones.size(), " start poses (expected 2)");
+  auto rows = [&](const std::vector<std::vector<Isometry>>& seq, const std::string& name) {
+    std::vector<double> out(seq.size() * size_t(J) * 7);
+    for (size_t s = 0; s < seq.size(); ++s) {
+      require(std::int64_t(seq[s].size()) == J, path, ": ", name, " entry ", s, " has ", seq[s].size(),
+              " bones, expected ", J, " (24 per body)");
+      for (std::int64_t j = 0; j < J; ++j)
+        pose_to_row(seq[s][size_t(j)], &out[(s * size_t(J) + size_t(j)) * 7],
+                    path + ": " + name + " entry " + std::to_string(s) + ", bone " + std::to_string(j));
+    }
+    return out;
+  };
+  file_->write_nd("/steps/bones", rows(r.step_bones, "/steps/bones").data(), {S, J, 7});
+  file_->write_nd("/meta/start_bones", rows(r.start_bones, "/meta/start_bones").data(), {2, J, 7});
+}
+
 void ResultWriter::finish(const SimulationResult& r) {
   auto& f = *file_;
   f.write_scalar("/meta/format_version", std::int64_t(kResultFormatVersion));
@@ -272,6 +294,7 @@ void ResultWriter::finish(const SimulationResult& r) {
   f.write_nd("/steps/newton_decrement", r.step_decrement.data(), {S});
   f.write_nd("/steps/outcome", r.step_outcome.data(), {S});
   f.write_nd("/steps/ms", r.step_ms.data(), {S});
+  write_bones(r);
   write_tool_events(r.tool_events);
   f.commit();
 }
@@ -348,6 +371,19 @@ void read_tools(const io::Hdf5File& f, const std::string& path, std::int64_t F, 
 }
 
 }  // namespace
+
+std::vector<std::vector<Isometry>> read_result_poses(const io::Hdf5File& f, const std::string& path,
+                                                     const std::string& name, std::int64_t entries,
+                                                     std::int64_t bones) {
+  const std::vector<double> rows = f.read_nd(name, {entries, bones, 7});
+  std::vector<std::vector<Isometry>> out(static_cast<size_t>(entries));
+  for (std::int64_t s = 0; s < entries; ++s)
+    for (std::int64_t j = 0; j < bones; ++j)
+      out[size_t(s)].push_back(pose_from_row(&rows[size_t((s * bones + j) * 7)], path + ": dataset " + name +
+                                                                                   ", entry " + std::to_string(s) +
+                                                                                   ", bone " + std::to_string(j)));
+  return out;
+}
 
 static SimulationResult read_simulation_result_in_this_process(const std::string& path) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
@@ -446,6 +482,11 @@ static SimulationResult read_simulation_result_in_this_process(const std::string
   vec("/steps/grad_norm", r.step_grad_norm);
   vec("/steps/newton_decrement", r.step_decrement);
   vec("/steps/ms", r.step_ms);
+  if (f.has("/steps/bones") || f.has("/meta/start_bones")) {  // absent in files written before they existed
+    const std::int64_t J = 24 * std::int64_t(num_bodies(r));
+    r.step_bones = read_result_poses(f, path, "/steps/bones", std::int64_t(r.step_time.size()), J);
+    r.start_bones = read_result_poses(f, path, "/meta/start_bones", 2, J);
+  }
   std::vector<double> outcome;
   vec("/steps/outcome", outcome);
   for (double o : outcome) {

@@ -332,6 +332,18 @@ SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& opt, Scen
   SimulationResult r = scene.result_header();
   FrameRecorder frames(scene, opt, r);
   ContactStatsRecorder contact(scene);
+  // Every body's bones, at the start (t − h, t) and after each step (SimulationResult::step_bones).
+  auto bones = [&](bool previous) {
+    std::vector<Isometry> out;
+    for (int b = 0; b < scene.num_bodies(); ++b) {
+      const Simulator& sim = scene.simulator();
+      const int k = scene.body_model_index(b);
+      const std::vector<Isometry>& g = previous ? sim.previous_state(k).bones : sim.state(k).bones;
+      out.insert(out.end(), g.begin(), g.end());
+    }
+    return out;
+  };
+  r.start_bones = {bones(true), bones(false)};
   Progress progress("simulating " + r.motion, steps);
   while (scene.steps_done() < steps) {
     const long k = scene.steps_done();
@@ -350,6 +362,7 @@ SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& opt, Scen
     const double t = (k + 1) * scene.dt();
     contact.add_step(t, rep);
     r.add_step(t, rep);
+    r.step_bones.push_back(bones(false));
     if (opt.on_step) opt.on_step(scene.simulator(), rep);
     frames.add_step(t, rep.ms_total);
     if (opt.progress) progress.update(k + 1);

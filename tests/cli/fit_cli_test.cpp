@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "sflsh/asset/avatar_file.hpp"
+#include "sflsh/fit/observations.hpp"
 #include "sflsh/scene/material_file.hpp"
 #include "fit/fit_fixture.hpp"
 #include "test_support.hpp"
@@ -67,6 +68,55 @@ TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("bad.yaml"))) << args;
     EXPECT_FALSE(std::filesystem::exists(dir.file("bad_error.svg"))) << args;
   }
+}
+
+TEST(FitCli, ARunWithDynamicBonesIsFittedWithItsOwnBones) {
+  // simulate's default (dynamic bones) with the soft region's moduli doubled:
+  // the bones the run took are not the motion's. With the bones the result
+  // file holds (/steps/bones), the fit recovers the factor; the same skin
+  // without them (prescribing the motion's bones) is off by much more.
+  test::TempDir dir;
+  const Avatar a = test::fit_avatar();
+  const std::string avatar = dir.file("box.h5"), truth = dir.file("truth.yaml"), obs = dir.file("obs.h5");
+  write_avatar(a, avatar);
+  std::vector<RegionMaterial> t = a.materials;
+  t[0].young_along *= 2, t[0].young_through *= 2, t[0].young_around *= 2;
+  write_material_file(truth, t);
+  std::string out;
+  ASSERT_EQ(run("simulate --avatar " + avatar + " --motion builtin:shake --seconds 0.5 --material " + truth +
+                    " --out " + obs,
+                &out),
+            0)
+      << out;
+  const Observations o = read_observations(obs);
+  ASSERT_EQ(o.bones, "dynamic");
+  ASSERT_EQ(o.step_bones.size(), 30u);
+  const std::string plain = dir.file("plain.h5");
+  test::write_observation_file(plain, o.time, o.positions, "builtin:shake");
+  auto fitted_factor = [&](const std::string& observed, const std::string& name) {
+    const std::string fitted = dir.file(name + ".yaml");
+    EXPECT_EQ(run("fit --avatar " + avatar + " --observed " + observed + " --params young --regions soft --out " +
+                      fitted,
+                  &out),
+              0)
+        << out;
+    std::vector<RegionMaterial> back = a.materials;
+    apply_material_file(fitted, back);
+    return back[0].young_along / a.materials[0].young_along;
+  };
+  const double own = fitted_factor(obs, "own");
+  EXPECT_NE(out.find("bones: the observed run's own"), std::string::npos) << out;
+  const double motion = fitted_factor(plain, "motion");
+  EXPECT_EQ(out.find("bones: the observed run's own"), std::string::npos) << out;
+  std::cout << "fitted factor (truth 2): own bones " << own << ", the motion's " << motion << "\n";
+  EXPECT_NEAR(own, 2.0, 0.04);
+  EXPECT_GT(std::abs(motion - 2.0), 3 * std::abs(own - 2.0));
+  // The run's bones are per step of its dt: another time step is refused in one line, with no output.
+  const std::string bad = dir.file("bad.yaml");
+  EXPECT_EQ(run("fit --avatar " + avatar + " --observed " + obs + " --params young --dt 1/120 --out " + bad, &out), 1);
+  EXPECT_NE(out.find("its run's bones are per step of 0.0166"), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+  EXPECT_FALSE(std::filesystem::exists(bad));
 }
 
 TEST(FitCli, DatasetMapAndItsMaterialsForANewShape) {

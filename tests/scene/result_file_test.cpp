@@ -298,6 +298,8 @@ struct RawFile {
   int object_groups = -1;  ///< /objects/<i> groups written (-1: = objects)
   double quaternion_scale = 1.0;
   int face_index = 2;      ///< the skin triangle's last index (3 vertices)
+  int bone_steps = -1;     ///< entries of /steps/bones (-1: no bones; the file has 3 steps)
+  double bone_quaternion_scale = 1.0;
 };
 
 void write_raw(const std::string& path, const RawFile& o) {
@@ -346,6 +348,17 @@ void write_raw(const std::string& path, const RawFile& o) {
   for (const char* n : {"/steps/time", "/steps/energy", "/steps/grad_norm", "/steps/newton_decrement", "/steps/ms"})
     f.write_nd(n, steps, {3});
   f.write_nd("/steps/outcome", outcome, {3});
+  if (o.bone_steps >= 0) {
+    // Entry s, bone j: at (0.1 j, s, −1), turned 0.1 s j rad about y (half of it in the quaternion).
+    std::vector<double> rows;
+    for (int s = 0; s < o.bone_steps; ++s)
+      for (int j = 0; j < 24; ++j)
+        for (double x : {0.1 * j, double(s), -1.0, o.bone_quaternion_scale * std::cos(0.05 * s * j), 0.0,
+                         o.bone_quaternion_scale * std::sin(0.05 * s * j), 0.0})
+          rows.push_back(x);
+    f.write_nd("/steps/bones", rows.data(), {o.bone_steps, 24, 7});
+    f.write_nd("/meta/start_bones", rows.data(), {2, 24, 7});
+  }
   f.commit();
 }
 
@@ -415,4 +428,65 @@ TEST(ResultFile, ReaderRejectsMalformedScenes) {
   o = RawFile();
   o.face_index = 3;
   expect_rejected(o, {"bad.h5", "/surface/faces"});
+}
+
+TEST(ResultFile, EveryStepsBonesComeBackAndBadOnesAreRefused) {
+  // Bones with distinct rotations and translations per step, bone and start
+  // entry: read back to round-off (stored as position + unit quaternion).
+  test::TempDir tmp;
+  SimulationResult r = small_result();
+  auto bones = [](double k) {
+    std::vector<Isometry> g;
+    for (int j = 0; j < 24; ++j) {
+      Isometry T = Isometry::Identity();
+      T.linear() = Eigen::AngleAxisd(0.1 * j + k, Vec3(1, 2, 3 + k).normalized()).toRotationMatrix();
+      T.translation() = Vec3(0.01 * j, -k, 0.5 + 0.001 * j * k);
+      g.push_back(T);
+    }
+    return g;
+  };
+  r.start_bones = {bones(-2.0), bones(-1.0)};
+  for (size_t s = 0; s < r.step_time.size(); ++s) r.step_bones.push_back(bones(0.3 * double(s)));
+  write_simulation_result(r, tmp.file("r.h5"));
+  const SimulationResult b = read_simulation_result(tmp.file("r.h5"));
+  ASSERT_EQ(b.step_bones.size(), r.step_bones.size());
+  ASSERT_EQ(b.start_bones.size(), 2u);
+  auto same = [](const std::vector<Isometry>& x, const std::vector<Isometry>& y) {
+    double d = 0;
+    for (size_t j = 0; j < x.size(); ++j) d = std::max(d, (x[j].matrix() - y[j].matrix()).cwiseAbs().maxCoeff());
+    return d;
+  };
+  EXPECT_LT(same(b.start_bones[0], r.start_bones[0]), 1e-14);
+  EXPECT_LT(same(b.start_bones[1], r.start_bones[1]), 1e-14);
+  for (size_t s = 0; s < r.step_bones.size(); ++s) EXPECT_LT(same(b.step_bones[s], r.step_bones[s]), 1e-14) << s;
+  // Without bones (a live run, an older file) neither dataset is written and none is read.
+  write_simulation_result(small_result(), tmp.file("none.h5"));
+  EXPECT_TRUE(read_simulation_result(tmp.file("none.h5")).step_bones.empty());
+  // A step without its bones, and a pose that is not rigid, are refused naming what.
+  SimulationResult short_run = r;
+  short_run.step_bones.pop_back();
+  test::expect_error([&] { write_simulation_result(short_run, tmp.file("bad.h5")); },
+                     {"bad.h5", "7 steps of bones for 8 steps"});
+  SimulationResult sheared = r;
+  sheared.step_bones[2][5].linear()(0, 1) += 0.1;
+  test::expect_error([&] { write_simulation_result(sheared, tmp.file("bad.h5")); },
+                     {"bad.h5", "/steps/bones entry 2, bone 5", "not a rigid motion"});
+  EXPECT_FALSE(std::filesystem::exists(tmp.file("bad.h5")));
+  RawFile o;
+  o.bone_steps = 3;
+  o.bone_quaternion_scale = 1.5;
+  write_raw(tmp.file("bad.h5"), o);
+  test::expect_error([&] { read_simulation_result(tmp.file("bad.h5")); },
+                     {"bad.h5", "/steps/bones, entry 0, bone 0", "unit quaternion"});
+  o.bone_quaternion_scale = 1.0;
+  o.bone_steps = 2;  // the file has 3 steps
+  write_raw(tmp.file("bad.h5"), o);
+  test::expect_error([&] { read_simulation_result(tmp.file("bad.h5")); }, {"bad.h5", "/steps/bones"});
+  o.bone_steps = 3;
+  write_raw(tmp.file("good.h5"), o);
+  const SimulationResult g = read_simulation_result(tmp.file("good.h5"));
+  ASSERT_EQ(g.step_bones.size(), 3u);
+  // Step 2, bone 5 as write_raw makes it: at (0.5, 2, −1), turned 1 rad about y (w = cos 0.5, y = sin 0.5).
+  EXPECT_LT((g.step_bones[2][5].translation() - Vec3(0.5, 2, -1)).norm(), 1e-15);
+  EXPECT_LT((g.step_bones[2][5].linear() - Eigen::AngleAxisd(1.0, Vec3::UnitY()).toRotationMatrix()).norm(), 1e-14);
 }

@@ -38,6 +38,7 @@ std::string check_command(const std::string& kind, const std::string& dir) {
   if (kind == "contact") return std::string(kPython) + " " + scripts + "contact_figures.py --check " + dir;
   if (kind == "patch_stress") return std::string(kPython) + " " + scripts + "patch_stress.py --check " + dir;
   if (kind == "fit") return std::string(kPython) + " " + scripts + "fit_benchmark.py --check " + dir;
+  if (kind == "fit_dynamic") return std::string(kPython) + " " + scripts + "fit_dynamic_bones.py --check " + dir;
   if (kind == "sparse_subspace")
     return std::string(kPython) + " " + scripts + "sparse_subspace.py --no-run --work " + dir + " --out " + dir +
            "/sparse_subspace.md";
@@ -69,7 +70,8 @@ TEST_P(FigureScriptCheck, JudgesTheCraftedFolder) {
     EXPECT_EQ(out.find("| figure |"), std::string::npos) << out;
   }
   if (c.exit_code == 0) EXPECT_EQ(out.find("**no**"), std::string::npos) << out;
-  if (c.exit_code == 1 && (c.kind == "teleop" || c.kind == "contact" || c.kind == "patch_stress"))  // the table is printed, the row marked
+  if (c.exit_code == 1 && (c.kind == "teleop" || c.kind == "contact" || c.kind == "patch_stress" ||
+                          c.kind == "fit_dynamic"))  // the table is printed, the row marked
     EXPECT_NE(out.find("**no**"), std::string::npos) << out;
 }
 
@@ -120,6 +122,9 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"fit", "good", 0, {"| forearm | x0.4 | x0.4040 | +1.0% ok"}},
         Case{"fit", "cmu_fung_missed", 1, {"target missed: cmu forearm fung_c: -27.2% (target ±10%)"}},
         Case{"fit", "cmu_no_iterations_line", 2, {"fit_cmu.log: no 'Iterations: N' line"}},
+        Case{"fit_dynamic", "good", 0, {"| x1.9986 (-0.1 %) | yes", "x1.4533 (-27.3 %)", "0.495 → 0.047 mm"}},
+        Case{"fit_dynamic", "own_missed", 1, {"target missed: belly Young's factor", "x2.1200 (+6.0 %)"}},
+        Case{"fit_dynamic", "own_no_factor", 2, {"fit_own.log: no '  young:belly  xF ...' line"}},
         Case{"batch_resume", "good", 0, {"batch_resume_check: passed"}},
         Case{"batch_resume", "worker_survived", 1, {"1 worker process(es) outlived the killed batch"}},
         Case{"batch_resume", "not_identical", 1, {"5 of 6 files bit-identical"}},

@@ -1,12 +1,14 @@
 #pragma once
 // Observed skin motion for `sflsh fit`: a file in the result-file
 // layout (scene/result_file.hpp: /frames/time (Fr,), /frames/positions
-// (Fr,V,3), optional /meta/motion, /meta/dt, /meta/bones) or a PC2 point cache
+// (Fr,V,3), optional /meta/motion, /meta/dt, /meta/bones, and the run's own
+// bones /meta/start_bones and /steps/bones) or a PC2 point cache
 // (frames only; their times are i / fps). Vertices in the avatar surface's order.
 #include <string>
 #include <vector>
 
 #include "sflsh/core/types.hpp"
+#include "sflsh/sim/configuration.hpp"
 
 namespace sflsh {
 
@@ -17,12 +19,17 @@ struct Observations {
   std::string motion;             ///< /meta/motion when the file has it (else empty)
   double dt = 0;                  ///< /meta/dt (s) when present, else 0
   std::string bones;              ///< /meta/bones ("kinematic" | "dynamic") when present
+  /// The observed run's own bones when the file has them (a one-body result's
+  /// /meta/start_bones and /steps/bones): start_bones[0] at t = −h, [1] at 0,
+  /// step_bones[s] (24 each) at the end of step s + 1. Empty otherwise.
+  std::vector<std::vector<Isometry>> start_bones, step_bones;
 };
 
 /// Reads `path` (.h5/.hdf5: result layout; .pc2: point cache at `pc2_fps`
 /// frames per second). Throws one line naming the file and what is wrong:
 /// missing datasets, shapes, frame times not strictly increasing or negative,
-/// non-finite positions (naming the frame and vertex).
+/// non-finite positions (naming the frame and vertex), bones that are not
+/// rigid poses (naming the dataset, step and bone).
 Observations read_observations(const std::string& path, double pc2_fps = 30.0);
 
 /// Throws unless every frame has `num_vertices` rows (the avatar's surface).

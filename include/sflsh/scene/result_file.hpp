@@ -56,6 +56,12 @@
 //                                      Only when C > 0; absent in older files (= no contacts).
 //   /steps/{time, energy, grad_norm, newton_decrement, outcome, ms}   (S,) per step
 //     outcome: 0 accepted, 1 damped, 2 rejected
+//   /steps/bones          (S,24·B,7)   every body's bones at the end of each step, as
+//                                      /frames/object_poses (position, then unit quaternion
+//                                      w x y z); rows 24b..24b+23 are body b's
+//   /meta/start_bones     (2,24·B,7)   the same at t − h and t of the run's start
+//   (both absent in files written before they existed and in live runs; `sflsh fit`
+//   prescribes them to reproduce a run with dynamic bones)
 #include <memory>
 #include <string>
 
@@ -114,6 +120,8 @@ class ResultWriter {
   void append_tool_frames(const std::vector<ToolFrame>& tools, const std::string& at);
   /// /tool_events (nothing when there are none).
   void write_tool_events(const std::vector<ToolEvent>& events);
+  /// /steps/bones and /meta/start_bones (nothing when the result has none).
+  void write_bones(const SimulationResult& result);
 
   std::unique_ptr<io::Hdf5File> file_;
   int frames_ = 0;
@@ -123,6 +131,14 @@ class ResultWriter {
   std::vector<std::string> tool_names_;
   std::vector<ContactTrack> contacts_;  ///< term and body of each contact (no frames)
 };
+
+/// Dataset `name` of `f` (the file at `path`) holding poses as the result file
+/// stores them (position, then unit quaternion w x y z), shape (entries,
+/// bones, 7): entries × bones transforms. Throws one line naming the file,
+/// the dataset and the entry and bone of a pose that is not finite or rigid.
+std::vector<std::vector<Isometry>> read_result_poses(const io::Hdf5File& f, const std::string& path,
+                                                     const std::string& name, std::int64_t entries,
+                                                     std::int64_t bones);
 
 /// Writes a whole result; /frames/target_pelvis only when the result has it,
 /// the bodies and objects when it has them (every object a pose per frame).

@@ -139,6 +139,11 @@ struct SimulationResult {
   std::vector<Vec3> frame_target_pelvis;  ///< empty when read from a file without it
   std::vector<double> step_time, step_energy, step_grad_norm, step_decrement, step_ms;
   std::vector<int> step_outcome;
+  /// Every body's 24 bones (body b's at 24 b .. 24 b + 23) at the end of each
+  /// step, and at the run's start: start_bones[0] at t − h, [1] at t. What
+  /// `sflsh fit` prescribes to reproduce a run whose bones were dynamic. Empty
+  /// when not recorded (read from a file without them, a live run).
+  std::vector<std::vector<Isometry>> step_bones, start_bones;
   int num_frames = 0;  ///< output frames made (kept or not)
   /// Distance between the simulated pelvis (joint 0) and the motion's pelvis
   /// over the output frames (kept or not), m; pelvis_frames = 0 when unknown.
