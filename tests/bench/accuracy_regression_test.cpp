@@ -10,9 +10,12 @@
 // a figure in scripts/results/bench*.md.
 //
 // The head, hand and foot barely move in the reference (their floors exceed
-// 1): their rel_err is pinned too, but it is the trunk and limb regions that
-// carry the figure. Skinning only (u = 0, rel_err 1 everywhere) must exceed
-// the pins of the regions below 0.86: the pins can fail.
+// 1): their rel_err is a ratio of two small numbers, and on another CPU (the
+// coarse mesh is built by CGAL on the machine) the foot's went from 1.02 to
+// 1.77 while the simulated regions moved by up to 6 %. They are checked
+// finite, not pinned; the trunk and limb regions carry the figure. Skinning
+// only (u = 0, rel_err 1 everywhere) must exceed the pins of the regions below
+// 0.86: the pins can fail.
 //
 // Measured (2026-11-28, Release, 2 cores, on the template whose topology serves every
 // shape: its repairs are designed over 25 shapes) with
@@ -64,9 +67,10 @@ TEST(AccuracyRegression, ReducedJumpOnACoarseBodyStaysWithinItsPinnedErrorPerReg
   const std::map<std::string, double> measured = {
       {"overall", 0.3274}, {"torso", 0.3390}, {"belly", 0.2828},     {"chest", 0.2850},
       {"buttocks", 0.3401}, {"thigh", 0.3198}, {"calf", 0.6129},     {"upper_arm", 0.7599},
-      {"forearm", 0.8206}, {"neck", 0.7982},  {"head", 1.6328},      {"hand", 0.9470},
-      {"foot", 1.0159},
+      {"forearm", 0.8206}, {"neck", 0.7982},
   };
+  // Measured 1.6328, 0.9470, 1.0159: reported, checked finite (header).
+  const std::vector<std::string> unpinned = {"head", "hand", "foot"};
   // The names whose rel_err in `row` (overall and per region) exceeds its pin.
   auto over_the_pins = [&](const BenchRow& row) {
     std::map<std::string, double> got = {{"overall", row.rel_err}};
@@ -98,7 +102,10 @@ TEST(AccuracyRegression, ReducedJumpOnACoarseBodyStaysWithinItsPinnedErrorPerReg
     ADD_FAILURE() << name << ": rel_err " << got << " (NaN: no reference motion) above the pin "
                   << kRelativeRoom * measured.at(name) + kAbsoluteRoom << " (measured " << measured.at(name) << ")";
   }
-  EXPECT_EQ(reduced->regions.size() + 1, measured.size()) << "regions with reference motion changed";
+  EXPECT_EQ(reduced->regions.size() + 1, measured.size() + unpinned.size()) << "regions with reference motion changed";
+  for (const RegionError& g : reduced->regions)
+    if (std::find(unpinned.begin(), unpinned.end(), g.name) != unpinned.end())
+      EXPECT_TRUE(std::isfinite(g.rel_err)) << g.name << ": rel_err " << g.rel_err;
   const std::vector<std::string> skinning_over = over_the_pins(*skinning);
   for (const char* name :
        {"overall", "torso", "belly", "chest", "buttocks", "thigh", "calf", "upper_arm", "forearm", "neck"})

@@ -1,6 +1,7 @@
 // Golden results of run_simulation, recorded with the single-avatar runtime
 // before the model/state redesign: every later change to the
-// runtime's structure must reproduce them within 1e-12 (relative). They are
+// runtime's structure must reproduce them within 1e-9 (relative; kGoldenRelative
+// in test_support.hpp says why not closer: other CPUs differ by ~1e-12). They are
 // fingerprints of the whole trajectory (sums over every output frame of z and
 // of the joints), so a change anywhere in the state shows.
 //
@@ -19,6 +20,7 @@
 #include "sflsh/scene/simulation_run.hpp"
 #include "sim/skeleton_fixture.hpp"
 #include "sim/synthetic_avatar.hpp"
+#include "test_support.hpp"
 
 using namespace sflsh;
 
@@ -72,7 +74,7 @@ void expect_golden(const char* name, const Fingerprint& f, const Fingerprint& go
                 f.joints_weighted, f.energy_sum);
     return;
   }
-  auto near = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
+  auto near = [](double a, double b) { return std::abs(a - b) <= test::kGoldenRelative * std::max(1.0, std::abs(b)); };
   EXPECT_TRUE(near(f.z_sum, golden.z_sum)) << name << " z_sum " << f.z_sum << " vs " << golden.z_sum;
   EXPECT_TRUE(near(f.z_sq, golden.z_sq)) << name << " z_sq " << f.z_sq << " vs " << golden.z_sq;
   EXPECT_TRUE(near(f.z_weighted, golden.z_weighted)) << name << " z_weighted " << f.z_weighted << " vs "
@@ -81,11 +83,10 @@ void expect_golden(const char* name, const Fingerprint& f, const Fingerprint& go
                                                      << golden.joints_sum;
   EXPECT_TRUE(near(f.joints_weighted, golden.joints_weighted))
       << name << " joints_weighted " << f.joints_weighted << " vs " << golden.joints_weighted;
-  // The energy sum (~1.5e3 J over every step, terms that nearly cancel) moves
-  // by ~3e-11 relative when the Hessian's sums are reassociated (the
-  // exact speed-ups), while z and the joints stay within 1e-12.
-  auto near_energy = [](double a, double b) { return std::abs(a - b) <= 1e-10 * std::max(1.0, std::abs(b)); };
-  EXPECT_TRUE(near_energy(f.energy_sum, golden.energy_sum)) << name << " energy_sum " << f.energy_sum << " vs "
+  // The energy sum (~1.5e3 J over every step, terms that nearly cancel)
+  // moves by ~3e-11 relative when the Hessian's sums are reassociated (the
+  // exact speed-ups): within the same bound.
+  EXPECT_TRUE(near(f.energy_sum, golden.energy_sum)) << name << " energy_sum " << f.energy_sum << " vs "
                                                      << golden.energy_sum;
 }
 
