@@ -20,15 +20,23 @@ int run(const std::string& args, std::string* out) {
   return test::run_command(test::sflsh_binary() + " -q " + args, out);
 }
 
+/// Writes `a` to `avatar` and, to `truth`, its materials with each region's three Young's moduli scaled by
+/// `young[r]`; returns those materials.
+std::vector<RegionMaterial> write_box_and_truth(const Avatar& a, const std::string& avatar, const std::string& truth,
+                                                const std::vector<double>& young) {
+  write_avatar(a, avatar);
+  std::vector<RegionMaterial> t = a.materials;
+  for (size_t r = 0; r < young.size(); ++r)
+    t[r].young_along *= young[r], t[r].young_through *= young[r], t[r].young_around *= young[r];
+  write_material_file(truth, t);
+  return t;
+}
+
 TEST(FitCli, FitsSimulatedObservationsAndRejectsBadInput) {
   test::TempDir dir;
   const Avatar a = test::fit_avatar();
   const std::string avatar = dir.file("box.h5"), truth = dir.file("truth.yaml"), obs = dir.file("obs.h5");
-  write_avatar(a, avatar);
-  std::vector<RegionMaterial> t = a.materials;
-  t[0].young_along *= 2, t[0].young_through *= 2, t[0].young_around *= 2;
-  t[1].young_along *= 0.5, t[1].young_through *= 0.5, t[1].young_around *= 0.5;
-  write_material_file(truth, t);
+  const std::vector<RegionMaterial> t = write_box_and_truth(a, avatar, truth, {2.0, 0.5});
   std::string out;
   ASSERT_EQ(run("simulate --avatar " + avatar + " --motion builtin:shake --seconds 0.5 --bones kinematic "
                     "--newton-nonlinearity-tol 0 --material " +
@@ -78,10 +86,7 @@ TEST(FitCli, ARunWithDynamicBonesIsFittedWithItsOwnBones) {
   test::TempDir dir;
   const Avatar a = test::fit_avatar();
   const std::string avatar = dir.file("box.h5"), truth = dir.file("truth.yaml"), obs = dir.file("obs.h5");
-  write_avatar(a, avatar);
-  std::vector<RegionMaterial> t = a.materials;
-  t[0].young_along *= 2, t[0].young_through *= 2, t[0].young_around *= 2;
-  write_material_file(truth, t);
+  write_box_and_truth(a, avatar, truth, {2.0, 1.0});
   std::string out;
   ASSERT_EQ(run("simulate --avatar " + avatar + " --motion builtin:shake --seconds 0.5 --material " + truth +
                     " --out " + obs,
