@@ -71,7 +71,7 @@ TEST(SceneDescription, ExampleScenesParse) {
   ASSERT_EQ(ball.objects.size(), 1u);
   EXPECT_EQ(ball.objects[0].kind, ObjectKind::Dynamic);
   EXPECT_EQ(ball.objects[0].mass, 0.43);
-  EXPECT_EQ(ball.solver.dt, 1.0 / 120);
+  EXPECT_EQ(ball.solver.dt, 1.0 / 240);
   const SceneDescription walkers = read_scene_description(folder.file("two_walkers.yaml"));
   ASSERT_EQ(walkers.bodies.size(), 2u);
   EXPECT_EQ(walkers.bodies[1].heading_deg, 180);

@@ -365,6 +365,70 @@ TEST(ContactPatch, OutOfContactThePatchDecaysWithItsReleaseTimeAndLeaves) {
   EXPECT_TRUE(sim.state().z.allFinite());
 }
 
+/// det F of every tet under the subspace's displacement W z (brute force).
+VecX subspace_determinants(const Avatar& a, const VecX& z) {
+  const std::vector<fem::TetGradient> g = fem::tet_gradients(a.tet);
+  VecX det(a.tet.num_elements());
+  for (int t = 0; t < a.tet.num_elements(); ++t) {
+    Mat3 F = Mat3::Identity();
+    for (int k = 0; k < 4; ++k) {
+      const int n = a.tet.elements(t, k);
+      Vec3 u = Vec3::Zero();
+      for (int h = 0; h < a.num_handles(); ++h) u += a.W.coeff(n, h) * z.segment<3>(3 * h);
+      F += u * g[size_t(t)].row(k);
+    }
+    det[t] = F.determinant();
+  }
+  return det;
+}
+
+TEST(ContactPatch, ANodeInATetTheSubspaceInvertsIsLeftOutAndTheStepStartsAdmissible) {
+  // The elastic cubature samples few tets, so the subspace can invert one it
+  // does not sample; the patch integrates its tets exactly and no δu starts
+  // such a tet admissible. A hat handle near the ball displaced by s along e
+  // gives det F = 1 − s/R on its side (x − h) ∥ e: s = 1.6 R inverts the tets
+  // there. The term must leave their nodes out (and keep the others), so that
+  // its energy at the step's start is finite: with them in, the step failed
+  // ("not finite at the start of iteration 0"; a ball thrown at the belly).
+  const Avatar a = slab(4);
+  const double R = 0.012;
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = Vec3(0.003, 0.03 + R - 0.001, -0.002);
+  ContactPatchOptions o;
+  o.patch_radius = 0.02;
+  o.max_patch_nodes = 100000;
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(R), Isometry::Identity(), false, o);
+  int tried = 0, kept = 0;
+  for (int h = 0; h < a.num_handles(); ++h)
+    for (int axis = 0; axis < 3; ++axis) {
+      StepContext ctx = context(a, &frames, false);
+      ctx.q_prev.z.segment<3>(3 * h)[axis] = 1.6 * 0.05;  // slab(): hat radius 5 cm
+      ctx.q_prev2 = ctx.q_prev;
+      const VecX det = subspace_determinants(a, ctx.q_prev.z);
+      // The patch without the subspace's displacement: which nodes it would take.
+      StepContext rest = context(a, &frames, false);
+      const auto rest_cache = begin_term_step(term, rest);
+      const std::vector<int> all = term.patch_nodes(rest);
+      std::vector<char> in_inverted(size_t(a.tet.num_nodes()), 0);
+      for (int t = 0; t < a.tet.num_elements(); ++t)
+        if (det[t] <= 0)
+          for (int k = 0; k < 4; ++k) in_inverted[size_t(a.tet.elements(t, k))] = 1;
+      int inverted_in_patch = 0;
+      for (int n : all) inverted_in_patch += in_inverted[size_t(n)];
+      if (inverted_in_patch == 0 || inverted_in_patch == int(all.size())) continue;  // not a mixed case
+      ++tried;
+      const auto cache = begin_term_step(term, ctx);
+      const std::vector<int> nodes = term.patch_nodes(ctx);
+      kept += !nodes.empty();  // (the displaced skin can leave the ball: no patch)
+      for (int n : nodes) EXPECT_FALSE(in_inverted[size_t(n)]) << "node " << n << " of an inverted tet is in the patch";
+      VecX g = VecX::Zero(ctx.layout.size());
+      const double E = term.evaluate(ctx, ctx.q_prev, &g, nullptr);
+      EXPECT_TRUE(std::isfinite(E) && g.allFinite()) << "handle " << h << " axis " << axis << ": E = " << E;
+    }
+  EXPECT_GT(tried, 0) << "no displacement inverted some of the patch's tets and not all";
+  EXPECT_GT(kept, 0) << "no case kept a patch";
+}
+
 TEST(ContactPatch, ThePatchIsTheSimulatedNodesWithinItsRadiusOfTheNearSkin) {
   // A 1.2 cm ball 1 mm into the slab's top, body and ball at rest: the near
   // skin is the vertices within the margin of the ball (φ < margin), and the

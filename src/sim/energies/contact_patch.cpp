@@ -20,6 +20,14 @@
 
 namespace sflsh {
 
+namespace {
+/// A released patch's tets keep at least this volume ratio det F as δu
+/// decays (keep_start_admissible); below it the patch is minimized instead.
+/// Far below what a release meets otherwise (a 20-fold crush): 0.5 changed a
+/// pinch's release on the coarse box avatar of the scene goldens.
+constexpr double kReleaseMinVolumeRatio = 0.05;
+}  // namespace
+
 using contact_patch_detail::add_offset_rotation_gradient;
 using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
@@ -305,9 +313,102 @@ void ContactPatchTerm::prepare_bulk_hessian(TermCache& cache) const {
   c.bulk_tets = c.tets;
 }
 
+std::vector<double> ContactPatchTerm::patch_tet_determinants(const TermCache& cache, const VecX& z,
+                                                           const VecX& du) const {
+  const PatchCache& c = static_cast<const PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  std::vector<Vec3> u(c.tet_nodes.size(), Vec3::Zero());  // W_n z at each node of the patch's tets
+  for (size_t i = 0; i < c.tet_nodes.size(); ++i) {
+    const int n = c.tet_nodes[i];
+    if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
+      u[i] += it.value() * z.segment<3>(3 * it.col());
+  }
+  std::vector<double> det(c.tets.size());
+  for (size_t ti = 0; ti < c.tets.size(); ++ti) {
+    Mat3 F = Mat3::Identity();
+    for (int k = 0; k < 4; ++k) {
+      const int slot = c.tet_slot[ti][size_t(k)];
+      const Vec3 uk = slot >= 0 ? Vec3(u[size_t(c.tet_local[ti][size_t(k)])] + du.segment<3>(3 * slot))
+                                : u[size_t(c.tet_local[ti][size_t(k)])];
+      F += uk * grads_[c.tets[ti]].row(k);
+    }
+    det[ti] = F.determinant();
+  }
+  return det;
+}
+
+double ContactPatchTerm::keep_start_admissible(TermCache& cache, const VecX& z,
+                                               const std::unordered_map<int, PatchHistory>& left, double decay) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  auto carried = [&](double scale) {  // the nodes' displacement at t, scaled, in slot order
+    VecX du = VecX::Zero(3 * long(c.nodes.size()));
+    for (size_t i = 0; i < c.nodes.size(); ++i) {
+      const auto h = c.history.find(c.nodes[i]);
+      if (h != c.history.end()) du.segment<3>(3 * long(i)) = scale * h->second.du;
+    }
+    return du;
+  };
+  // A node that left returns (with its history) to a tet that its last
+  // micrometre kept admissible: a tet the subspace alone crushes.
+  for (bool changed = !left.empty(); changed;) {
+    changed = false;
+    const std::vector<double> det = patch_tet_determinants(c, z, carried(1.0));
+    for (size_t ti = 0; ti < c.tets.size(); ++ti) {
+      if (det[ti] > 0) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int n = a.tet.elements(c.tets[ti], k);
+        const auto l = left.find(n);
+        if (l == left.end() || c.history.count(n)) continue;
+        c.history.emplace(n, l->second);
+        if (!c.node_slot.count(n)) c.node_slot.emplace(n, int(c.nodes.size())), c.nodes.push_back(n);
+        changed = true;
+      }
+    }
+    if (changed) prepare_patch_tets(c);
+  }
+  auto remove_nodes = [&](const std::vector<char>& drop) {
+    std::vector<int> kept;
+    for (size_t i = 0; i < c.nodes.size(); ++i)
+      if (!drop[i]) kept.push_back(c.nodes[i]);
+    c.nodes = std::move(kept);
+    prepare_patch_tets(c);
+  };
+  // New nodes in a tet the subspace inverts: left out while it does.
+  for (;;) {
+    const std::vector<double> det = patch_tet_determinants(c, z, carried(1.0));
+    std::vector<char> drop(c.nodes.size(), 0);
+    bool any = false;
+    for (size_t ti = 0; ti < c.tets.size(); ++ti) {
+      if (det[ti] > 0) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int slot = c.tet_slot[ti][size_t(k)];
+        if (slot >= 0 && !c.history.count(c.nodes[size_t(slot)])) drop[size_t(slot)] = 1, any = true;
+      }
+    }
+    if (!any) break;
+    remove_nodes(drop);
+  }
+  if (!c.releasing) return decay;
+  // A released patch decays while the subspace can take its tets back: with
+  // a tet crushed below kReleaseMinVolumeRatio of its volume (the subspace
+  // alone nearly or wholly inverts it) δu stays minimized, its barrier holding the tet,
+  // until the subspace relaxes. Prescribed there, δu froze the tet near
+  // det F = 0 while z moved on, and the step's energy ran to 1e17.
+  for (double d : patch_tet_determinants(c, z, carried(decay)))
+    if (!(d >= kReleaseMinVolumeRatio)) {
+      c.releasing = false;
+      return 1.0;
+    }
+  return decay;
+}
+
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   PatchCache& c = patch_cache(ctx, name());
   // The displacement fixed at the end of the last step becomes the one at t.
+  // Nodes whose displacement has released leave (kept aside: a tet may still need them).
+  std::unordered_map<int, PatchHistory> left;
   for (auto it = c.history.begin(); it != c.history.end();) {
     PatchHistory& h = it->second;
     h.d_prev = h.d_t;
@@ -315,10 +416,12 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     h.du_prev = h.du;
     h.du = h.du_next;
     const double rel = options_.release_displacement;
-    if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel)
+    if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel) {
+      left.emplace(it->first, h);
       it = c.history.erase(it);
-    else
+    } else {
       ++it;
+    }
   }
   std::vector<int> near;
   std::vector<double> near_phi;  // φ of each near vertex at t
@@ -329,11 +432,12 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   c.releasing = near.empty();
   select_patch_nodes(c, near, near_phi);
   prepare_patch_tets(c);
-  prepare_bulk_hessian(c);
-  // Predictions and the warm start.
   const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
                                          : ctx.bound[0];
   const Configuration& qt = *b.q_prev;
+  const double decay = keep_start_admissible(c, qt.z, left, std::exp(-ctx.h / options_.release_time));
+  prepare_bulk_hessian(c);
+  // Predictions and the warm start.
   const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();
   const size_t P = c.nodes.size();
   c.x_star.assign(P, Vec3::Zero());
@@ -352,7 +456,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     c.du.segment<3>(3 * i) = h->second.du;
     c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev;
   }
-  if (c.releasing) c.du *= std::exp(-ctx.h / options_.release_time);
+  if (c.releasing) c.du *= decay;
   c.samples_in_patch.clear();
   c.sample_x_star.clear();
   for (int s = 0; s < int(sample_node_.size()); ++s)

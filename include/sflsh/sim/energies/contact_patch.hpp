@@ -99,6 +99,10 @@
 
 namespace sflsh {
 
+namespace contact_patch_detail {
+struct PatchHistory;  // contact_patch_cache.hpp
+}
+
 struct ContactPatchOptions {
   double pressure_stiffness = kDefaultPressureStiffness;  ///< κ, N/m³
   double spacing = kDefaultContactSpacing;                ///< m, face sample spacing
@@ -235,6 +239,23 @@ class ContactPatchTerm : public EnergyTerm {
                           std::vector<double>& near_phi) const;
   void collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const;
   void prepare_patch_tets(TermCache& cache) const;
+  /// det F(W z + δu) of each patch tet (cache order).
+  std::vector<double> patch_tet_determinants(const TermCache& cache, const VecX& z, const VecX& du) const;
+  /// Keeps the patch's start admissible at the subspace's state z (time t),
+  /// with the nodes' displacement at t (every tet's det F > 0):
+  ///  - a node that `left` the patch this step (δu below
+  ///    release_displacement) returns with its history to a tet that needs
+  ///    its δu (one the subspace alone crushes);
+  ///  - a new node in a tet the subspace inverts is left out while it does
+  ///    (no δu starts it admissible: the subspace's elastic term samples few
+  ///    tets, so an inverted tet it does not sample goes unnoticed until a
+  ///    patch reaches it);
+  ///  - a released patch decays by `decay` only while its tets keep a volume
+  ///    ratio of kReleaseMinVolumeRatio; else it is minimized this step.
+  ///    Returns the factor.
+  double keep_start_admissible(TermCache& cache, const VecX& z,
+                               const std::unordered_map<int, contact_patch_detail::PatchHistory>& left,
+                               double decay) const;
   /// The bulk share of Φ_zz the patch tets add (cache's bulk_hessian), kept while they stay the same.
   void prepare_bulk_hessian(TermCache& cache) const;
   /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
