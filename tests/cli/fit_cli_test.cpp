@@ -27,7 +27,7 @@ std::vector<RegionMaterial> write_box_and_truth(const Avatar& a, const std::stri
   write_avatar(a, avatar);
   std::vector<RegionMaterial> t = a.materials;
   for (size_t r = 0; r < young.size(); ++r)
-    t[r].young_along *= young[r], t[r].young_through *= young[r], t[r].young_around *= young[r];
+    t[r].scale_young(young[r]);
   write_material_file(truth, t);
   return t;
 }

@@ -316,14 +316,7 @@ void ContactPatchTerm::prepare_bulk_hessian(TermCache& cache) const {
 std::vector<double> ContactPatchTerm::patch_tet_determinants(const TermCache& cache, const VecX& z,
                                                            const VecX& du) const {
   const PatchCache& c = static_cast<const PatchCache&>(cache);
-  const Avatar& a = *avatar_;
-  std::vector<Vec3> u(c.tet_nodes.size(), Vec3::Zero());  // W_n z at each node of the patch's tets
-  for (size_t i = 0; i < c.tet_nodes.size(); ++i) {
-    const int n = c.tet_nodes[i];
-    if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
-      u[i] += it.value() * z.segment<3>(3 * it.col());
-  }
+  const std::vector<Vec3> u = contact_patch_detail::tet_node_subspace_displacements(*avatar_, c, z);
   std::vector<double> det(c.tets.size());
   for (size_t ti = 0; ti < c.tets.size(); ++ti) {
     Mat3 F = Mat3::Identity();
@@ -338,8 +331,8 @@ std::vector<double> ContactPatchTerm::patch_tet_determinants(const TermCache& ca
   return det;
 }
 
-double ContactPatchTerm::keep_start_admissible(TermCache& cache, const VecX& z,
-                                               const std::unordered_map<int, PatchHistory>& left, double decay) const {
+void ContactPatchTerm::keep_start_admissible(TermCache& cache, const VecX& z,
+                                             const std::unordered_map<int, PatchHistory>& left, double decay) const {
   PatchCache& c = static_cast<PatchCache&>(cache);
   const Avatar& a = *avatar_;
   auto carried = [&](double scale) {  // the nodes' displacement at t, scaled, in slot order
@@ -390,7 +383,7 @@ double ContactPatchTerm::keep_start_admissible(TermCache& cache, const VecX& z,
     if (!any) break;
     remove_nodes(drop);
   }
-  if (!c.releasing) return decay;
+  if (!c.releasing) return;
   // A released patch decays while the subspace can take its tets back: with
   // a tet crushed below kReleaseMinVolumeRatio of its volume (the subspace
   // alone nearly or wholly inverts it) δu stays minimized, its barrier holding the tet,
@@ -399,9 +392,8 @@ double ContactPatchTerm::keep_start_admissible(TermCache& cache, const VecX& z,
   for (double d : patch_tet_determinants(c, z, carried(decay)))
     if (!(d >= kReleaseMinVolumeRatio)) {
       c.releasing = false;
-      return 1.0;
+      return;
     }
-  return decay;
 }
 
 void ContactPatchTerm::begin_step(const StepContext& ctx) const {
@@ -435,7 +427,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, &ctx.q_prev2}
                                          : ctx.bound[0];
   const Configuration& qt = *b.q_prev;
-  const double decay = keep_start_admissible(c, qt.z, left, std::exp(-ctx.h / options_.release_time));
+  const double decay = std::exp(-ctx.h / options_.release_time);  // of a released patch's δu
+  keep_start_admissible(c, qt.z, left, decay);
   prepare_bulk_hessian(c);
   // Predictions and the warm start.
   const bool has_prev = b.q_prev2 && b.q_prev2->bones.size() == qt.bones.size();

@@ -108,6 +108,10 @@ struct PatchedVertex {
   std::array<std::pair<int, double>, 4> couple;  // (patch slot or −1, barycentric weight) per tet node
 };
 
+/// The subspace's displacement W_n z (unposed) at each node of the patch's
+/// tets (`c.tet_nodes` order); zero at nodes that are not Simulated.
+std::vector<Vec3> tet_node_subspace_displacements(const Avatar& a, const PatchCache& c, const VecX& z);
+
 /// Vertex `v` of `vertices` (the term's skin points) at q with δu (slots of `c`).
 PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const PatchCache& c, int v,
                              const Configuration& q, const VecX& du);

@@ -22,8 +22,20 @@ using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
 using contact_patch_detail::patched_vertex;
 using contact_patch_detail::PatchedVertex;
+using contact_patch_detail::tet_node_subspace_displacements;
 
 namespace contact_patch_detail {
+std::vector<Vec3> tet_node_subspace_displacements(const Avatar& a, const PatchCache& c, const VecX& z) {
+  std::vector<Vec3> u(c.tet_nodes.size(), Vec3::Zero());
+  for (size_t i = 0; i < c.tet_nodes.size(); ++i) {
+    const int n = c.tet_nodes[i];
+    if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it)
+      u[i] += it.value() * z.segment<3>(3 * it.col());
+  }
+  return u;
+}
+
 PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const PatchCache& c, int v,
                              const Configuration& q, const VecX& du) {
   PatchedVertex p;
@@ -197,13 +209,8 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   const Avatar& a = *avatar_;
   const int z0 = local_layout(ctx).z_offset();
   auto simulated = [&](int n) { return a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated); };
-  // The subspace's displacement W_n z at each node of the patch's tets.
   const size_t nt = c.tet_nodes.size();
-  std::vector<Vec3> us(nt, Vec3::Zero());
-  for (size_t i = 0; i < nt; ++i)
-    if (simulated(c.tet_nodes[i]))
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, c.tet_nodes[i]); it; ++it)
-        us[i] += it.value() * q.z.segment<3>(3 * it.col());
+  const std::vector<Vec3> us = tet_node_subspace_displacements(a, c, q.z);
   // Per tet node: ∂Φ/∂u_n and the cross blocks K0 against the patch slots,
   // taken through W once per node after the loop.
   std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());

@@ -252,10 +252,9 @@ class ContactPatchTerm : public EnergyTerm {
   ///    patch reaches it);
   ///  - a released patch decays by `decay` only while its tets keep a volume
   ///    ratio of kReleaseMinVolumeRatio; else it is minimized this step.
-  ///    Returns the factor.
-  double keep_start_admissible(TermCache& cache, const VecX& z,
-                               const std::unordered_map<int, contact_patch_detail::PatchHistory>& left,
-                               double decay) const;
+  void keep_start_admissible(TermCache& cache, const VecX& z,
+                             const std::unordered_map<int, contact_patch_detail::PatchHistory>& left,
+                             double decay) const;
   /// The bulk share of Φ_zz the patch tets add (cache's bulk_hessian), kept while they stay the same.
   void prepare_bulk_hessian(TermCache& cache) const;
   /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
