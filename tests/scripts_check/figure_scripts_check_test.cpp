@@ -105,13 +105,14 @@ INSTANTIATE_TEST_SUITE_P(
 INSTANTIATE_TEST_SUITE_P(
     Contact, FigureScriptCheck,
     ::testing::Values(
-        Case{"contact", "good", 0, {"664 N up, |horizontal| 2.5 N (0.0038) | yes"}},
+        Case{"contact", "good", 0, {"664 N up, |horizontal| 2.5 N (0.0038) | yes", "0 / 0, 103 N | yes"}},
         Case{"contact", "floor_force_slanted", 1, {"target missed: floor force at rest", "200.0 N (0.3012)"}},
         Case{"contact", "floor_nan", 1, {"target missed: rejected steps, NaN: 0, NaN"}},
         Case{"contact", "slab_force_off", 1, {"target missed: slab (2 kg)", "0.9001"}},
         Case{"contact", "momentum_lost", 1, {"target missed: two-body collision", "1.2e-03"}},
         Case{"contact", "walkers_missing_line", 2, {"two_walkers.log: no 'contact skin_contact on alice"}},
         Case{"contact", "walker_spike", 1, {"target missed: peak contact force", "2500 N"}},
+        Case{"contact", "ball_coarse_rejected", 1, {"target missed: ball_at_belly at 1/120 s", "0 / 82, 31992 N"}},
         Case{"contact", "walker_passes", 1, {"target missed: passes through", "yes"}},
         Case{"contact", "sphere_missing_dataset", 2, {"sphere_on_belly.h5: dataset '/frames/time' missing"}}),
     name_of);

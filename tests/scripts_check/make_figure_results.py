@@ -169,6 +169,9 @@ def contact(variant, d):
           "tool gripper t = 1.500 s: release 12 skin points of alice\n")
     write(p("ball_at_belly.log"), steps_line(360) + contact_line("contact:ball", 5.53, 19877.9, (0, 0, 0)))
     write(p("box_press.log"), steps_line(480) + contact_line("contact:press", 4.75, 38198.0, (0, 0, 0)))
+    coarse = variant == "ball_coarse_rejected"
+    write(p("ball_at_belly_dt120.log"), steps_line(360, rejected=82 if coarse else 0) +
+          contact_line("contact:ball", 52.05 if coarse else 0.77, 31992.3 if coarse else 103.2, (0, 0, 0)))
     frames = 13
     with h5py.File(p("sphere_on_belly.h5"), "w") as h:
         poses = np.zeros((frames, 1, 7))

@@ -12,7 +12,6 @@
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/rotation.hpp"
 #include "sflsh/fem/tet_operators.hpp"
-#include "sflsh/sim/compression_guard.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/energies/inertia.hpp"
 #include "sflsh/sim/linearized_stiffness.hpp"
@@ -102,14 +101,8 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     a.inertia.barycentric.row(s).maxCoeff(&k);
     sample_node_[size_t(s)] = a.tet.elements(a.inertia.elements[s], k);
   }
-  // What the subspace's elastic term holds of each tet (subspace_density).
+  // The subspace's quadratic share of each tet (subspace_quadratic_density).
   if (o.subspace_mean_dilatation) dilatation_cell_ = dilatation_cells(a);
-  cubature_weight_ = VecX::Zero(T);
-  for (int k = 0; k < a.elastic.size(); ++k) {
-    const int t = a.elastic.elements[k];
-    require(t >= 0 && t < T, what, ": elastic cubature sample ", k, " has tet ", t, ", expected in [0, ", T, ")");
-    cubature_weight_[t] += a.elastic.weights[k];
-  }
   // Broad phase: vertices by dominant bone and 10 cm cell (unposed), each
   // cluster with a bounding radius and 5 cm of slack for skinning blends and
   // soft displacement (as sdf_contact.hpp's clusters).

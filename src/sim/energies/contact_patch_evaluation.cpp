@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "sflsh/core/rotation.hpp"
-#include "sflsh/sim/compression_guard.hpp"
 #include "sflsh/sim/energies/elastic.hpp"
 #include "sflsh/sim/linearized_stiffness.hpp"
 #include "sflsh/sim/point_hessian.hpp"
@@ -51,8 +50,7 @@ PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const
 }
 }  // namespace contact_patch_detail
 
-double ContactPatchTerm::subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
-  const MaterialPoint& m = materials_[t];
+double ContactPatchTerm::subspace_quadratic_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
   Mat9 Hq = H2;
   if (dilatation_cell_.size() > 0 && dilatation_cell_[t] >= 0) {
     // The tet's own share of the mean-dilatation quadratic (linearized_stiffness.cpp):
@@ -67,27 +65,9 @@ double ContactPatchTerm::subspace_density(int t, const Mat3& F, const Mat9& H2, 
   const Mat3 D = F - Mat3::Identity();
   const Vec9 h = Eigen::Map<const Vec9>(D.data());
   const Vec9 Hqh = Hq * h;
-  double psi = 0.5 * h.dot(Hqh);
   if (P) *P = Eigen::Map<const Mat3>(Hqh.data());
   if (H) *H = Hq;
-  // The cubature's remainder Ψ − Ψ₂ (and the compression guard), weighted as the samples in the tet.
-  const double c = cubature_weight_[t] / tet_volume_[t];
-  if (c == 0.0) return psi;
-  Mat3 Pr;
-  Mat9 Hr;
-  const Vec9 H2h = H2 * h;
-  double r = strain_energy_density(F, m, P ? &Pr : nullptr, H ? &Hr : nullptr, true) - 0.5 * h.dot(H2h);
-  if (P) Pr -= Eigen::Map<const Mat3>(H2h.data());
-  if (H) Hr -= H2;
-  if (options_.subspace_mean_dilatation)
-    r += compression_guard(F, (1.0 - kPerTetVolumeShare) * m.kappa, kCompressionGuardOnset, P ? &Pr : nullptr,
-                           H ? &Hr : nullptr, true);
-  if (P) *P += c * Pr;
-  // The Hessian serves the cross block Φ_zp only (evaluate_patch): a sample
-  // standing for many tets' volume (c ≫ 1) holds its remainder with that
-  // weight, but δu couples to z through this tet's own volume.
-  if (H) *H += std::min(c, 1.0) * Hr;
-  return psi + c * r;
+  return 0.5 * h.dot(Hqh);
 }
 
 double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du,
@@ -194,7 +174,7 @@ ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, con
 
 // Elasticity: the exact change δu brings to each patch tet.
 // With mean dilatation the subspace holds only α of each tet's own bulk
-// stiffness (subspace_density), so Φ_zz gains the rest, (1 − α) κ_t V_t
+// stiffness (subspace_quadratic_density), so Φ_zz gains the rest, (1 − α) κ_t V_t
 // (Wᵀ b_t)(Wᵀ b_t)ᵀ with b_t the tet's volume-change gradient (κ_t = vᵀH₂v/9,
 // the rank-one bulk part of the material's small-strain Hessian): a PSD
 // Gauss–Newton part of Φ_zz that the one Newton step needs (without it the
@@ -234,14 +214,14 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
     if (!std::isfinite(psi1)) return std::numeric_limits<double>::infinity();
     const double V = tet_volume_[t];
     E += V * psi1;
-    // What the subspace's elastic term holds of the tet: constant while δu varies (left out then).
+    // The subspace's quadratic share of the tet: constant while δu varies (left out then).
     const Mat9& H2 = c.tet_H2[ti];
-    if (subspace) E -= V * subspace_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
+    if (subspace) E -= V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
     if (!p_derivatives) continue;
     const ElementBlocks K = element_blocks(grads_[t], V, H1);
-    // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken at the subspace's own
-    // state, Wᵀ K(Wz): the Schur complement Wᵀ K0 (K1 + M + C)⁻¹ K0 W then
-    // stays below the subspace's stiffness of these tets, Wᵀ K0 W, which its
+    // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken as the subspace's own
+    // quadratic stiffness of the tet, Wᵀ K0: the Schur complement
+    // Wᵀ K0 (K1 + M + C)⁻¹ K0 W then stays below Wᵀ K0 W, which the body's
     // elastic term carries, so the step's Hessian stays positive semi-definite
     // where the dent stiffens the tissue (K1 ≫ K0 under the Fung saturation).
     // Only the Hessian is approximated: the gradient and the energy are exact.

@@ -45,25 +45,25 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // compression makes them indefinite, then their PSD majorizers; Armijo
   // backtracking; stops when the Newton decrement −gᵀs falls below
   // inner_tolerance × |Φ| (or the gradient vanishes).
-  // A start that inverts a tet (the warm start, or the subspace itself at
-  // this q): the last minimizer, then no patch displacement; if every start
+  // The start: the lower energy of the warm start and the last minimizer (a
+  // warm start predicted past a tet's collapse starts the Newton iteration
+  // far up the compression barrier, where it gains only a constant factor
+  // of the energy per iteration), else no patch displacement; if every start
   // is inadmissible the term's energy is +inf there and the step backtracks.
   // A full step's trial is evaluated with its derivatives: accepted, it
   // starts the next iteration (Armijo's check and the next Newton step share
   // one evaluation).
+  double E_start = evaluate_patch(ctx, q, du, energy_only, trial);
+  if (c.du.size() == du.size() && c.du != du) {
+    const double E_last = evaluate_patch(ctx, q, c.du, energy_only, trial);
+    if (E_last < E_start || !std::isfinite(E_start)) du = c.du, E_start = E_last;
+  }
+  if (!std::isfinite(E_start)) du.setZero();
   bool evaluated = false;  // `ev` holds the evaluation at du
   double E0 = 0;
   for (int it = 0; it < options_.max_inner_iterations; ++it) {
     if (!evaluated) E0 = evaluate_patch(ctx, q, du, exact, ev);
     evaluated = false;
-    if (it == 0 && !std::isfinite(E0)) {
-      du = c.du;
-      E0 = evaluate_patch(ctx, q, du, exact, ev);
-      if (!std::isfinite(E0)) {
-        du.setZero();
-        E0 = evaluate_patch(ctx, q, du, exact, ev);
-      }
-    }
     if (!std::isfinite(E0)) break;
     if (ev.gp.norm() < 1e-12) break;
     Eigen::LLT<MatX> llt(ev.Hpp);

@@ -25,22 +25,28 @@
 // below) nothing but the contact remains without δu: the patch only refines.
 //
 // What the patch subtracts: the inertia samples S_p (their whole share of the
-// subspace's kinetic term), and Ψ_t^sub, what the body's elastic term holds of
-// tet t (elastic.hpp): the exact small-strain quadratic, with mean dilatation
-// only its own share of it (α H₂ + (1 − α) P H₂ P, the rest averaged over the
-// tet's cell and left in the subspace), plus the cubature's remainder Ψ − Ψ₂
-// (and compression guard) weighted by the samples in t (c_t = Σ w_s / V_t,
-// zero for most tets). Subtracting the tet's exact Ψ instead, as if the
-// subspace held it, gives local volume changes inside a patch a negative
-// stiffness of about the bulk modulus (the subspace holds α = 0.2 of it): a
-// 2 cm probe pressed 2 cm into the belly ran away within a second (the step's
-// Hessian indefinite beyond any diagonal shift). The same holds for inertia:
-// subtracting the nodes' exact |r_n|² where the mass cubature holds less made
-// a 1 cm probe yanked through the belly at 500 Hz blow the flesh up to 78 kJ
-// of elastic energy. With these subtractions the z-energy inside a patch is
-// what the subspace keeps (cell means, other samples) plus the relaxed exact
-// energy, bounded below; in the limit (exact cubatures, no mean dilatation)
-// they are the exact ones.
+// subspace's kinetic term), and Ψ_t^sub, tet t's share of the quadratic part
+// of the body's elastic term (elastic.hpp): the exact small-strain quadratic,
+// with mean dilatation only its own share of it (α H₂ + (1 − α) P H₂ P, the
+// rest averaged over the tet's cell and left in the subspace). Subtracting
+// the tet's exact Ψ instead, as if the subspace held it, gives local volume
+// changes inside a patch a negative stiffness of about the bulk modulus (the
+// subspace holds α = 0.2 of it): a 2 cm probe pressed 2 cm into the belly ran
+// away within a second (the step's Hessian indefinite beyond any diagonal
+// shift). The same holds for inertia: subtracting the nodes' exact |r_n|²
+// where the mass cubature holds less made a 1 cm probe yanked through the
+// belly at 500 Hz blow the flesh up to 78 kJ of elastic energy.
+//
+// The cubature's nonlinear remainder Ψ − Ψ₂ (and compression guard) at the
+// subspace's state stays: it is what keeps the subspace's own state sane
+// under a patch. Cancelled at the samples inside the patch, it left the
+// handles there nearly free (δu makes up for W z inside the patch), and a
+// football at 6 m/s, stepped at 1/120 s, drove z to crush a sample the patch
+// hid from the step: 0.76 MJ held by the subspace and cancelled by the patch,
+// until the patch released it (32 kN, 82 rejected steps). Kept, it costs
+// nothing where W z is small-strain (the remainder is cubic in the strain,
+// and the minimum over z and δu puts a dent into δu) and rises steeply where
+// the subspace would crush or overstretch a sample.
 //
 // Condensation (Teng et al. 2015, "Subspace condensation"): the term's energy
 // is E(q) = min_δu Φ(q, δu), the patch minimized out at every evaluation
@@ -58,7 +64,10 @@
 //
 // Limit: with the patch covering every Simulated node, the elastic cubature
 // exact per tet and the inertia lumped at the nodes, E(q) is the full FEM's
-// energy of u = Wz + δu minimized over δu: the step is the full-FEM step.
+// energy of u = Wz + δu minimized over δu, plus the remainder at W z, which
+// has no gradient and no Hessian at rest (cubic) and stays small while δu
+// takes the dent: the step is the full-FEM step (to 1e-6 of the dent,
+// contact_patch_test.cpp).
 //
 // Life of a patch: begin_step selects the candidate faces (a vertex within
 // reach of the object at time t) and the patch nodes (Simulated nodes within
@@ -228,11 +237,11 @@ class ContactPatchTerm : public EnergyTerm {
 
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
-  /// What the subspace's elastic term holds of tet `t` per unit volume at F
-  /// (J/m³; H2 the tet's small-strain Hessian), with its stress P; H
-  /// (PSD-projected) is the stiffness the cross block Φ_zp takes for the tet
-  /// (the remainder's weight capped at the tet's own volume).
-  double subspace_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
+  /// The share of tet `t` in the quadratic part of the body's elastic term,
+  /// per unit volume at F (J/m³; H2 the tet's small-strain Hessian), with its
+  /// stress P and its constant Hessian H (the stiffness the cross block Φ_zp
+  /// takes for the tet).
+  double subspace_quadratic_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
   // begin_step's parts (contact_patch.cpp), each filling the term's cache:
   /// The skin vertices near the object at t (increasing) and their φ; places the field at t + h.
   void find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
@@ -278,7 +287,6 @@ class ContactPatchTerm : public EnergyTerm {
   PosedPoints inertia_points_;     // the inertia cubature's samples
   VecX inertia_mass_;              // their masses, kg
   std::vector<int> sample_node_;   // their main node
-  VecX cubature_weight_;   // per tet: the elastic cubature's weights in it (m³)
   std::vector<MaterialPoint> materials_;
   std::vector<std::vector<int>> node_tets_;    // tets of each node
   std::vector<std::vector<int>> vertex_faces_;  // skin faces of each vertex
