@@ -367,20 +367,23 @@ TEST(ContactPatch, OutOfContactThePatchDecaysWithItsReleaseTimeAndLeaves) {
   EXPECT_TRUE(sim.state().z.allFinite());
 }
 
+/// F_t of the subspace's state W z alone, tet t.
+Mat3 subspace_gradient(const Avatar& a, const VecX& z, const std::vector<fem::TetGradient>& g, int t) {
+  Mat3 F = Mat3::Identity();
+  for (int k = 0; k < 4; ++k) {
+    const int n = a.tet.elements(t, k);
+    Vec3 u = Vec3::Zero();
+    for (int h = 0; h < a.num_handles(); ++h) u += a.W.coeff(n, h) * z.segment<3>(3 * h);
+    F += u * g[size_t(t)].row(k);
+  }
+  return F;
+}
+
 /// det F of every tet under the subspace's displacement W z (brute force).
 VecX subspace_determinants(const Avatar& a, const VecX& z) {
   const std::vector<fem::TetGradient> g = fem::tet_gradients(a.tet);
   VecX det(a.tet.num_elements());
-  for (int t = 0; t < a.tet.num_elements(); ++t) {
-    Mat3 F = Mat3::Identity();
-    for (int k = 0; k < 4; ++k) {
-      const int n = a.tet.elements(t, k);
-      Vec3 u = Vec3::Zero();
-      for (int h = 0; h < a.num_handles(); ++h) u += a.W.coeff(n, h) * z.segment<3>(3 * h);
-      F += u * g[size_t(t)].row(k);
-    }
-    det[t] = F.determinant();
-  }
+  for (int t = 0; t < a.tet.num_elements(); ++t) det[t] = subspace_gradient(a, z, g, t).determinant();
   return det;
 }
 
@@ -446,18 +449,6 @@ TEST(ContactPatch, ANodeInATetTheSubspaceInvertsIsLeftOutAndTheStepStartsAdmissi
     }
   EXPECT_GT(tried, 0) << "no displacement inverted some of the patch's tets and not all";
   EXPECT_GT(kept, 0) << "no case kept a patch";
-}
-
-/// F_t of the subspace's state W z alone, tet t.
-Mat3 subspace_gradient(const Avatar& a, const VecX& z, const std::vector<fem::TetGradient>& g, int t) {
-  Mat3 F = Mat3::Identity();
-  for (int k = 0; k < 4; ++k) {
-    const int n = a.tet.elements(t, k);
-    Vec3 u = Vec3::Zero();
-    for (int h = 0; h < a.num_handles(); ++h) u += a.W.coeff(n, h) * z.segment<3>(3 * h);
-    F += u * g[size_t(t)].row(k);
-  }
-  return F;
 }
 
 TEST(ContactPatch, UnderThePatchTheSubspaceKeepsItsNonlinearRemainder) {
