@@ -1,6 +1,7 @@
 #include "sflsh/sim/state.hpp"
 
 #include <cmath>
+#include <typeinfo>
 
 #include "sflsh/core/error.hpp"
 #include "sim/step_workspace.hpp"
@@ -9,18 +10,50 @@ namespace sflsh {
 
 State::State() = default;
 State::~State() = default;
-State::State(const State& other) : time(other.time), bodies(other.bodies) {}
+State::State(const State& other) : time(other.time), bodies(other.bodies), carried_(other.carried()) {}
 State& State::operator=(const State& other) {
+  if (this == &other) return *this;
   time = other.time;
   bodies = other.bodies;
+  carried_ = other.carried();
   workspace_.reset();
   return *this;
 }
 State::State(State&&) noexcept = default;
 State& State::operator=(State&&) noexcept = default;
 
+State::CarriedCaches State::carried() const {
+  CarriedCaches out;
+  if (workspace_) {
+    out.names = workspace_->term_names;
+    out.caches.resize(out.names.size());
+    for (size_t g = 0; g < workspace_->groups.size(); ++g)
+      for (size_t k = 0; k < workspace_->groups[g].caches.size(); ++k)
+        if (const TermCache* c = workspace_->groups[g].caches[k].get())
+          out.caches[size_t(workspace_->term_index[g][k])] = c->clone();
+  } else {
+    out.names = carried_.names;
+    for (const std::unique_ptr<TermCache>& c : carried_.caches) out.caches.push_back(c ? c->clone() : nullptr);
+  }
+  return out;
+}
+
 StepWorkspace& State::workspace(const Model& model) {
-  if (!workspace_ || workspace_->model != &model) workspace_ = std::make_unique<StepWorkspace>(model);
+  if (workspace_ && workspace_->model == &model) return *workspace_;
+  CarriedCaches take = workspace_ ? carried() : std::move(carried_);
+  carried_ = CarriedCaches();
+  workspace_ = std::make_unique<StepWorkspace>(model);
+  // A carried cache is taken up by the term of its place when the model has
+  // as many terms and that term has the same name and cache type.
+  if (take.names.size() == model.terms().size())
+    for (size_t g = 0; g < workspace_->groups.size(); ++g)
+      for (size_t k = 0; k < workspace_->groups[g].caches.size(); ++k) {
+        const size_t i = size_t(workspace_->term_index[g][k]);
+        std::unique_ptr<TermCache>& fresh = workspace_->groups[g].caches[k];
+        std::unique_ptr<TermCache>& kept = take.caches[i];
+        if (kept && fresh && take.names[i] == workspace_->term_names[i] && typeid(*kept) == typeid(*fresh))
+          fresh = std::move(kept);
+      }
   return *workspace_;
 }
 

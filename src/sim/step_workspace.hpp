@@ -24,13 +24,17 @@ struct GroupWorkspace {
 
 struct StepWorkspace {
   explicit StepWorkspace(const Model& m) : model(&m), groups(m.groups().size()) {
+    for (const Model::BoundTerm& t : m.terms()) term_names.push_back(t.term->name());
     for (size_t g = 0; g < m.groups().size(); ++g) {
+      term_index.push_back(m.groups()[g].terms);
       for (int i : m.groups()[g].terms) groups[g].caches.push_back(m.terms()[i].term->make_cache());
       groups[g].contexts.resize(m.groups()[g].terms.size());
     }
   }
-  const Model* model;
+  const Model* model;  ///< compared, never read once the workspace is made (the model may be gone)
   std::vector<GroupWorkspace> groups;
+  std::vector<std::vector<int>> term_index;  ///< per group, the model index of each of its terms
+  std::vector<std::string> term_names;       ///< by model index
 };
 
 }  // namespace sflsh

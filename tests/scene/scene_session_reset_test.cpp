@@ -195,3 +195,28 @@ bodies:
   ASSERT_GT(u1, 1e-6);
   EXPECT_NEAR(u4 / u1, 0.25, 0.01);
 }
+
+TEST_F(SessionReset, ChangingTheScaleInContactKeepsThePatchsDisplacement) {
+  // The contact patch's displacement δu (and its velocity history) is state
+  // the terms carry from step to step. Setting the scale rebuilds the model:
+  // a session set to its own scale (1) in the middle of a press must go on
+  // exactly as one left alone, not lose the dent (a pop, then a new patch).
+  std::string text = kPressScene;
+  text.replace(text.find("bodies:"), 0, "contact: {patch: true, friction: 0}\n");
+  text.erase(text.find("    coupling:"));  // kinematic: it stays pressed in
+  const SceneDescription sc = read_scene_description(write_scene(text.c_str()));
+  SceneSession rescaled(sc, quiet()), alone(sc, quiet());
+  double pressed = 0;
+  for (int i = 0; i < 60; ++i) {
+    rescaled.advance();
+    alone.advance();
+    pressed = std::max(pressed, alone.tool_state(0).force.norm());
+  }
+  ASSERT_GT(pressed, 0.1) << "the probe should press the flesh by now";
+  rescaled.set_stiffness_scale(1.0);
+  for (int i = 0; i < 5; ++i) {
+    rescaled.advance();
+    alone.advance();
+  }
+  expect_same_state(rescaled, alone);
+}

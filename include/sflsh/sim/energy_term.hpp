@@ -18,6 +18,9 @@
 // shared across threads and runs). Anything a term computes per step (e.g. the
 // inertia's explicit prediction x*) lives in its TermCache, which the State
 // owns: make_cache() creates it, begin_step() fills it, compute() reads it.
+// A cache that also carries state from one step to the next (the contact
+// patch's displacement and its history) says so with clone(): a copied State
+// carries a copy of it over, also to a model rebuilt with the same terms.
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +55,9 @@ struct WorldFrame {
 /// Per-step scratch a term owns inside the State (see header comment).
 struct TermCache {
   virtual ~TermCache() = default;
+  /// A copy when the cache carries state from step to step; null (the
+  /// default) when begin_step recomputes everything in it.
+  virtual std::unique_ptr<TermCache> clone() const { return nullptr; }
 };
 
 /// One body as a term sees it (several for terms that couple bodies).

@@ -3,8 +3,12 @@
 // q_{t−1}, the time, and the per-step caches of the model's terms; plus the
 // per-step inputs (motion targets per body, obstacles' and tools' world frames,
 // grasps' anchored points; by input id). A step is a function of (Model, State, StepInputs) (step.hpp).
-// A State can be copied (the copy gets fresh caches: they are recomputed at
-// the start of every step) and saved/restored (state_file.hpp).
+// A State can be copied and saved/restored (state_file.hpp). A copy gets
+// fresh caches (begin_step recomputes them), except those that carry state
+// from step to step (TermCache::clone): their copies go with it and are taken
+// up by the first step on a model whose term of that place has the same name
+// and cache type (the same model, or one rebuilt with its terms rescaled).
+// A state file holds the bodies only: a restored State starts without them.
 #include <memory>
 #include <string>
 #include <vector>
@@ -53,11 +57,20 @@ class State {
   State(State&&) noexcept;
   State& operator=(State&&) noexcept;
 
-  /// The step's scratch, created for `model` on first use.
+  /// The step's scratch, created for `model` on first use (taking up the
+  /// caches a copy carried over).
   StepWorkspace& workspace(const Model& model);
 
  private:
+  /// Copies of the caches that carry state, by model term index (null: none), with the terms' names.
+  struct CarriedCaches {
+    std::vector<std::unique_ptr<TermCache>> caches;
+    std::vector<std::string> names;
+  };
+  CarriedCaches carried() const;
+
   std::unique_ptr<StepWorkspace> workspace_;
+  CarriedCaches carried_;  ///< not yet taken up by a workspace
 };
 
 /// A state at rest for `model`: every bone G_i = I, z = 0, time 0.

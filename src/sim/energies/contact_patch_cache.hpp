@@ -42,6 +42,8 @@ struct PatchHistory {
 };
 
 struct PatchCache : TermCache {
+  /// The patch's displacement and its history are state (δu and its velocity carry over).
+  std::unique_ptr<TermCache> clone() const override { return std::make_unique<PatchCache>(*this); }
   Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h
   std::vector<int> faces;                      // candidate skin faces
   std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
