@@ -111,6 +111,24 @@ struct Golden {
   int events = 0;
 };
 
+/// Over several steps, iterative solves leave the last digits to the
+/// arithmetic: the patch's inner minimization stops at a Newton decrement of
+/// 1e-9 |Φ| (contact_patch_minimization.cpp), and a tool's force after 100
+/// steps of the yank differed by 9e-8 relative between two CPUs. The first
+/// step stays pinned at kGoldenRelative.
+constexpr double kAfterStepsRelative = 1e-6;
+
+/// Two box bodies pressed face to face (skin_contact, body_contact): the
+/// state after six steps moves by up to 3e-3 relative when one body is moved
+/// by 1e-13 m (measured at several offsets and headings; the first step by
+/// 1e-12): within a step the first Newton iteration agrees, the step's end
+/// state does not, and later steps carry it on: the soft DoFs' entries (z,
+/// |z|²) by up to 16 % between two CPUs. So a CPU whose arithmetic differs in
+/// the last bit gives another state after six steps; the first step stays
+/// pinned at kGoldenRelative, the later state only within this (a check of
+/// signs and magnitudes).
+constexpr double kBodyContactAfterSteps = 0.25;
+
 struct ExampleScene {
   const char* file;  ///< under apps/scenes, or (starting with '\n') the scene's text
 
@@ -120,6 +138,8 @@ struct ExampleScene {
   Golden golden;
   /// Called after the first step (e.g. to change the stiffness scale).
   std::function<void(SceneSession&)> after_first_step = nullptr;
+  /// Relative tolerance of the state after `steps` and of the tools' states.
+  double after_steps_relative = kAfterStepsRelative;
 };
 
 /// The box's front face (z = +0.03 m in its frame) at z = 0.11 m with the
@@ -161,8 +181,10 @@ class SceneCompileGolden : public test::BoxAvatarScene {
     EXPECT_EQ(got.terms, ex.golden.terms) << label;
     EXPECT_EQ(got.layout, ex.golden.layout) << label;
     test::expect_fingerprint(got.first_step, ex.golden.first_step, label + ": the state after one step");
-    test::expect_fingerprint(got.last_step, ex.golden.last_step, label + ": the state after " + std::to_string(ex.steps) + " steps");
-    test::expect_fingerprint(got.tools, ex.golden.tools, label + ": the tools' and objects' states");
+    test::expect_fingerprint(got.last_step, ex.golden.last_step,
+                             label + ": the state after " + std::to_string(ex.steps) + " steps", ex.after_steps_relative);
+    test::expect_fingerprint(got.tools, ex.golden.tools, label + ": the tools' and objects' states",
+                             ex.after_steps_relative);
     EXPECT_EQ(got.events, ex.golden.events) << label << ": grasp and release events";
   }
 };
@@ -230,7 +252,8 @@ TEST_F(SceneCompileGolden, TwoWalkers) {
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
           {0.016666666666666666, -28.436259695629246, 2102.9495594824693, -0.00065554696664747551, 8.0130683199127701e-07, -36, 2100, 0, 0, 59.297287416250974, 2994.1727636514261, -0.001311093933299125, 8.0130683199129691e-07, 72, 3000, 0, 0},
           {0.099999999999999992, -12.7823109467669, 2115.0704921928059, 0.023034762313700788, 0.00020646516241002415, -23.358251221906354, 2107.4867516447725, 0.03024168461309909, 0.00091738518026773807, 63.299905097850349, 2941.5748911949954, 0.046191639717521951, 0.00020868854058020981, 66.480834310090842, 2973.2725569532399, 0.060450228616607676, 0.00092133262156226462},
-          {0, 0, 0, 0, 0, 0, 0}, 0}});
+          {0, 0, 0, 0, 0, 0, 0}, 0},
+         nullptr, kBodyContactAfterSteps});
 }
 
 TEST_F(SceneCompileGolden, MomentumBump) {
@@ -243,7 +266,8 @@ TEST_F(SceneCompileGolden, MomentumBump) {
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
           {0.016666666666666666, -20.999999999999993, 2100, 1.7186169301130161e-16, 2.8020506339746206e-33, -36, 2100, 0, 0, 71.999999999999957, 3000, 6.3797971527910921e-20, 4.0246785091346352e-39, 72, 3000, 0, 0},
           {0.099999999999999992, 15.882833577224208, 2246.7695179443222, -3.8801237302378604e-05, 1.9588446076473564e-09, 9.4771772794992337, 2213.8394412103526, 1.5903829071801592e-05, 1.5631946541513177e-09, 147.87407411446821, 2704.1284620339261, -7.7602474604852699e-05, 1.9588446076467562e-09, 130.84259831695954, 2770.9278649195066, 3.1807658143790723e-05, 1.563194654151596e-09},
-          {0, 0, 0, 0, 0, 0, 0}, 0}});
+          {0, 0, 0, 0, 0, 0, 0}, 0},
+         nullptr, kBodyContactAfterSteps});
 }
 
 TEST_F(SceneCompileGolden, WalkerMeetsStander) {
@@ -256,7 +280,8 @@ TEST_F(SceneCompileGolden, WalkerMeetsStander) {
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
           {0.016666666666666666, -26.936142119671036, 2102.9477219079808, -0.00065555940932820924, 8.0130983528286036e-07, -36, 2100, 0, 0, 74.130329342029981, 2995.2479021569316, -0.0013117295364770652, 8.0128778101061851e-07, 72, 3000, 0, 0},
           {0.099999999999999992, 7.5438041633211501, 2113.9461410497147, -0.00084178605866440945, 1.4353300800137502e-06, -5.4801545334181831, 2109.796253547946, -0.00085799866609302081, 1.5222792367224787e-06, 116.83860324427344, 2987.5181020521727, -0.001851255184903448, 1.3317023608146763e-06, 110.69704951173134, 2992.1320393469873, -0.0016835495102830191, 1.3552971242298173e-06},
-          {0, 0, 0, 0, 0, 0, 0}, 0}});
+          {0, 0, 0, 0, 0, 0, 0}, 0},
+         nullptr, kBodyContactAfterSteps});
 }
 
 TEST_F(SceneCompileGolden, WalkerMeetsStanderWithCapsules) {
@@ -269,7 +294,8 @@ TEST_F(SceneCompileGolden, WalkerMeetsStanderWithCapsules) {
           "alice:1/24/18@0 bob:1/24/18@162 dofs 324 blocks 50 groups 1",
           {0.016666666666666666, -26.936142119671036, 2102.9477219079808, -0.00065555940932820924, 8.0130983528286036e-07, -36, 2100, 0, 0, 74.130329342029981, 2995.2479021569316, -0.0013117295364770652, 8.0128778101061851e-07, 72, 3000, 0, 0},
           {0.099999999999999992, 6.4465243950859357, 2112.4845963309708, -0.00098709459970918183, 1.4107776841646874e-06, -3.9023217592836996, 2118.8455654535487, -0.0020375283993556612, 4.4127784754741863e-06, 127.05768555190778, 2988.501450962468, -0.0018141652807641521, 1.4034584137661161e-06, 114.12996206608226, 2974.6441009372616, -0.0039894662643744343, 3.8682381220684052e-06},
-          {0, 0, 0, 0, 0, 0, 0}, 0}});
+          {0, 0, 0, 0, 0, 0, 0}, 0},
+         nullptr, kBodyContactAfterSteps});
 }
 
 TEST_F(SceneCompileGolden, PinchCoupled) {
