@@ -50,17 +50,17 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // far up the compression barrier, where it gains only a constant factor
   // of the energy per iteration), else no patch displacement; if every start
   // is inadmissible the term's energy is +inf there and the step backtracks.
-  // A full step's trial is evaluated with its derivatives: accepted, it
-  // starts the next iteration (Armijo's check and the next Newton step share
-  // one evaluation).
-  double E_start = evaluate_patch(ctx, q, du, energy_only, trial);
+  // The warm start, which usually starts the iteration, is evaluated with its
+  // derivatives; the last minimizer for its energy alone. A full step's trial
+  // is evaluated with its derivatives: accepted, it starts the next iteration
+  // (Armijo's check and the next Newton step share one evaluation).
+  double E0 = evaluate_patch(ctx, q, du, exact, ev);
+  bool evaluated = std::isfinite(E0);  // `ev` holds the evaluation at du
   if (c.du.size() == du.size() && c.du != du) {
     const double E_last = evaluate_patch(ctx, q, c.du, energy_only, trial);
-    if (E_last < E_start || !std::isfinite(E_start)) du = c.du, E_start = E_last;
+    if (E_last < E0 || !std::isfinite(E0)) du = c.du, E0 = E_last, evaluated = false;
   }
-  if (!std::isfinite(E_start)) du.setZero();
-  bool evaluated = false;  // `ev` holds the evaluation at du
-  double E0 = 0;
+  if (!std::isfinite(E0)) du.setZero(), evaluated = false;
   for (int it = 0; it < options_.max_inner_iterations; ++it) {
     if (!evaluated) E0 = evaluate_patch(ctx, q, du, exact, ev);
     evaluated = false;
