@@ -2,7 +2,14 @@
 
 #include <optional>
 
+#include "sflsh/core/error.hpp"
+
 namespace sflsh {
+
+void TermCache::restore_state(const std::vector<double>& values, const std::string& where) {
+  require(values.empty(), where, ": this term's cache carries no state, the checkpoint gives it ", values.size(),
+          " values");
+}
 
 double EnergyTerm::evaluate(const StepContext& ctx, const Configuration& q, VecX* grad, MatX* hess) const {
   if (!grad && !hess) return compute(ctx, q, nullptr, nullptr);

@@ -38,6 +38,24 @@ State::CarriedCaches State::carried() const {
   return out;
 }
 
+std::vector<std::unique_ptr<TermCache>> State::carried_caches(std::vector<std::string>* names) const {
+  CarriedCaches c = carried();
+  if (names) *names = std::move(c.names);
+  return std::move(c.caches);
+}
+
+void State::carry_cache(const Model& model, int term, std::unique_ptr<TermCache> cache) {
+  require(term >= 0 && term < int(model.terms().size()), "State::carry_cache: term ", term, " is not one of the model's ",
+          model.terms().size());
+  if (workspace_) carried_ = carried(), workspace_.reset();
+  if (carried_.names.size() != model.terms().size()) {
+    carried_ = CarriedCaches();
+    for (const Model::BoundTerm& t : model.terms()) carried_.names.push_back(t.term->name());
+    carried_.caches.resize(carried_.names.size());
+  }
+  carried_.caches[size_t(term)] = std::move(cache);
+}
+
 StepWorkspace& State::workspace(const Model& model) {
   if (workspace_ && workspace_->model == &model) return *workspace_;
   CarriedCaches take = workspace_ ? carried() : std::move(carried_);

@@ -1,6 +1,9 @@
 #include "sflsh/sim/state_file.hpp"
 
 #include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/io/hdf5_file.hpp"
@@ -48,6 +51,19 @@ void write_state(const std::string& path, const Model& model, const State& state
     f.write_nd(g + "z", s.q.z.data(), {s.q.z.size()});
     f.write_nd(g + "z_prev", s.q_prev.z.data(), {s.q_prev.z.size()});
   }
+  std::vector<std::string> term_names;
+  const std::vector<std::unique_ptr<TermCache>> caches = state.carried_caches(&term_names);
+  std::vector<int> saved;
+  for (size_t j = 0; j < caches.size(); ++j) {
+    if (!caches[j]) continue;
+    const std::vector<double> values = caches[j]->saved_state();
+    if (values.empty()) continue;
+    const std::string g = "/state/caches/" + std::to_string(j) + "/";
+    f.write_string(g + "name", term_names[j]);
+    f.write_nd(g + "values", values.data(), {std::int64_t(values.size())});
+    saved.push_back(int(j));
+  }
+  if (!saved.empty()) f.write_nd("/state/caches/terms", saved.data(), {std::int64_t(saved.size())});
   f.commit();
 }
 
@@ -56,8 +72,8 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
   require(f.has("/meta/kind") && f.read_string("/meta/kind") == "sflsh state", path,
           ": not an sflsh state file (/meta/kind is missing or not \"sflsh state\")");
   const double version = f.read_scalar("/meta/format_version");
-  require(version == kStateFormatVersion, path, ": /meta/format_version is ", version, ", expected ",
-          kStateFormatVersion);
+  require(version == 1 || version == kStateFormatVersion, path, ": /meta/format_version is ", version,
+          ", expected 1 to ", kStateFormatVersion);
   const std::vector<std::string> names = f.read_strings("/state/bodies");
   require(names.size() == model.bodies().size(), path, ": /state/bodies has ", names.size(),
           " bodies, the scene has ", model.bodies().size());
@@ -82,6 +98,21 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
     validate_state(model, s);
   } catch (const Error& e) {
     fail(path, ": ", e.what());
+  }
+  if (!f.has("/state/caches/terms")) return s;
+  const auto terms = f.read_int_matrix("/state/caches/terms", -1, 1);
+  for (Eigen::Index k = 0; k < terms.rows(); ++k) {
+    const int j = terms(k, 0);
+    require(j >= 0 && j < int(model.terms().size()), path, ": /state/caches/terms[", k, "] is ", j,
+            ", the scene has ", model.terms().size(), " terms");
+    const std::string g = "/state/caches/" + std::to_string(j) + "/";
+    const EnergyTerm& term = *model.terms()[size_t(j)].term;
+    const std::string name = f.read_string(g + "name");
+    require(name == term.name(), path, ": ", g, "name is '", name, "', the scene's term ", j, " is '", term.name(), "'");
+    std::unique_ptr<TermCache> cache = term.make_cache();
+    require(cache != nullptr, path, ": ", g, " holds a state for term '", name, "', which keeps none");
+    cache->restore_state(f.read_nd(g + "values", {-1}), path + ": " + g + "values");
+    s.carry_cache(model, j, std::move(cache));
   }
   return s;
 }

@@ -58,6 +58,12 @@ struct TermCache {
   /// A copy when the cache carries state from step to step; null (the
   /// default) when begin_step recomputes everything in it.
   virtual std::unique_ptr<TermCache> clone() const { return nullptr; }
+  /// What a checkpoint keeps of the state it carries (state_file.hpp), as
+  /// doubles; empty (the default) when it carries nothing or holds nothing now.
+  virtual std::vector<double> saved_state() const { return {}; }
+  /// Restores saved_state()'s values into a fresh cache; throws naming
+  /// `where` when they cannot be such values (length, NaN, indices).
+  virtual void restore_state(const std::vector<double>& values, const std::string& where);
 };
 
 /// One body as a term sees it (several for terms that couple bodies).

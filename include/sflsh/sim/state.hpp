@@ -8,7 +8,7 @@
 // from step to step (TermCache::clone): their copies go with it and are taken
 // up by the first step on a model whose term of that place has the same name
 // and cache type (the same model, or one rebuilt with its terms rescaled).
-// A state file holds the bodies only: a restored State starts without them.
+// A state file holds the bodies and what those caches carry (saved_state).
 #include <memory>
 #include <string>
 #include <vector>
@@ -60,6 +60,13 @@ class State {
   /// The step's scratch, created for `model` on first use (taking up the
   /// caches a copy carried over).
   StepWorkspace& workspace(const Model& model);
+
+  /// Copies of the caches that carry state (TermCache::clone) with their
+  /// terms' names, by model term index (null: none).
+  std::vector<std::unique_ptr<TermCache>> carried_caches(std::vector<std::string>* names = nullptr) const;
+  /// Hands `cache` to term `term` of `model` for the next step, as a copy of
+  /// a State carries it (a state file's restored caches).
+  void carry_cache(const Model& model, int term, std::unique_ptr<TermCache> cache);
 
  private:
   /// Copies of the caches that carry state, by model term index (null: none), with the terms' names.

@@ -3,13 +3,18 @@
 // and resume bit-identically (`sflsh simulate --checkpoint F` / `--resume F`).
 //
 // Layout (names fixed; SI units):
-//   /meta/format_version   1
+//   /meta/format_version   2 (1: without /state/caches; read as well)
 //   /meta/kind             "sflsh state"
 //   /state/time            s
 //   /state/bodies          (B,) body names, in model order
 //   /state/<i>/bones       (24, 12) q_t: per bone the row-major rotation (9) then the translation (3)
 //   /state/<i>/bones_prev  (24, 12) q_{t−1}
 //   /state/<i>/z, z_prev   (3K,)    reduced soft DoFs at t and t − h
+//   /state/caches/terms    (C,)     the model terms whose caches carry state
+//                                   from step to step (TermCache::saved_state),
+//                                   e.g. the contact patch's displacement
+//   /state/caches/<j>/name          term j's name (checked against the scene)
+//   /state/caches/<j>/values (N,)   its saved state
 // Doubles are stored exactly (no float32), so a restored state equals the saved one.
 #include <string>
 
@@ -18,13 +23,14 @@
 
 namespace sflsh {
 
-inline constexpr int kStateFormatVersion = 1;
+inline constexpr int kStateFormatVersion = 2;
 
 /// Writes `state` of `model` to `path` (atomically: NAME.partial, then renamed).
 void write_state(const std::string& path, const Model& model, const State& state);
 
 /// Reads a state saved for a model like `model`: the body names, their count
-/// and each body's K must match (else one error naming the file and field).
+/// and each body's K must match, and each saved cache's term its name (else
+/// one error naming the file and field).
 State read_state(const std::string& path, const Model& model);
 
 }  // namespace sflsh

@@ -126,7 +126,11 @@ int ContactPatchTerm::object_offset(const StepContext& ctx) const {
   return ctx.bound[1].layout.base;
 }
 
-std::unique_ptr<TermCache> ContactPatchTerm::make_cache() const { return std::make_unique<PatchCache>(); }
+std::unique_ptr<TermCache> ContactPatchTerm::make_cache() const {
+  auto c = std::make_unique<PatchCache>();
+  c->num_nodes = avatar_->tet.num_nodes();
+  return c;
+}
 
 std::vector<int> ContactPatchTerm::patch_nodes(const StepContext& ctx) const { return patch_cache(ctx, name()).nodes; }
 

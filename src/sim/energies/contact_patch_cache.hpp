@@ -2,6 +2,7 @@
 // Private to contact_patch*.cpp: the term's per-step cache and one evaluation
 // of Φ and its derivatives (contact_patch.hpp's header comment).
 #include <array>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -41,9 +42,17 @@ struct PatchHistory {
   Vec3 d_next = Vec3::Zero();
 };
 
+/// Doubles per node in PatchCache::saved_state.
+inline constexpr size_t kPatchHistoryValues = 13;
+
 struct PatchCache : TermCache {
   /// The patch's displacement and its history are state (δu and its velocity carry over).
   std::unique_ptr<TermCache> clone() const override { return std::make_unique<PatchCache>(*this); }
+  /// The history, per node in increasing order: the node, then δu, d_t, δu_next
+  /// and d_next (kPatchHistoryValues each): what begin_step reads of it.
+  std::vector<double> saved_state() const override;
+  void restore_state(const std::vector<double>& values, const std::string& where) override;
+  int num_nodes = 0;  // the avatar's tet nodes (a restored node must be one)
   Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h
   std::vector<int> faces;                      // candidate skin faces
   std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
@@ -85,7 +94,7 @@ struct PatchCache : TermCache {
   VecX z_lin, du_lin;
   MatX Hpz;                     // Φ_pz (patch DoFs by z)
   Eigen::LLT<MatX> Hpp_llt;
-  std::unordered_map<int, PatchHistory> history;
+  std::map<int, PatchHistory> history;  // ordered: the patch's slots and a checkpoint do not depend on hashing
   // The step's anchors (PatchAnchors), by increasing vertex: the tool point at
   // t + h and at t, and the vertex (with its patch offset) at t; step frame.
   std::vector<int> anchor_vertices;

@@ -1,0 +1,162 @@
+// A checkpoint taken in the middle of a press (sim/state_file.hpp): the
+// contact patch's displacement δu and its history are state the term carries
+// from step to step, so the file holds them and a resumed run goes on as the
+// uninterrupted one. Bad caches in a file are refused naming the file and the
+// dataset.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene/box_avatar_fixture.hpp"
+#include "sflsh/io/hdf5_file.hpp"
+#include "sflsh/scene/scene_description.hpp"
+#include "sflsh/scene/scene_session.hpp"
+#include "sflsh/sim/state_file.hpp"
+#include "test_support.hpp"
+
+using namespace sflsh;
+
+namespace {
+
+/// A kinematic 5 mm sphere pressed 1 cm into the box's top by 0.2 s, under a patch.
+const char* kObjectPressScene = R"(
+solver: {dt: 1/250, seconds: 1, damping: 0.01}
+contact: {patch: true, friction: 0}
+bodies:
+  - {name: base, avatar: box.h5, bones: kinematic}
+objects:
+  - name: probe
+    shape: {type: sphere, radius: 0.005}
+    kind: kinematic
+    keyframes:
+      - {time: 0.0, position: [0.0, 0.040, 0.0]}
+      - {time: 0.2, position: [0.0, 0.020, 0.0]}
+)";
+
+SceneSessionOptions quiet() {
+  SceneSessionOptions o;
+  o.progress = false;
+  return o;
+}
+
+/// The saved states of the caches that carry one (by model term index, empty: none).
+std::vector<std::vector<double>> saved_caches(const SceneSession& s) {
+  std::vector<std::vector<double>> out;
+  for (const std::unique_ptr<TermCache>& c : s.simulator().scene_state().carried_caches())
+    out.push_back(c ? c->saved_state() : std::vector<double>());
+  return out;
+}
+
+class CheckpointResume : public test::BoxAvatarScene {
+ protected:
+  /// `steps` steps of the press, then its state written to DIR/NAME.
+  std::string checkpoint_after(int steps, const std::string& name) {
+    SceneSession s(scene(), quiet());
+    for (int i = 0; i < steps; ++i) s.advance();
+    const std::string path = (dir_ / name).string();
+    write_state(path, s.simulator().model(), s.simulator().scene_state());
+    return path;
+  }
+  SceneDescription scene() { return read_scene_description(write_scene(kObjectPressScene)); }
+};
+
+}  // namespace
+
+TEST_F(CheckpointResume, AMidPressCheckpointResumesWithThePatchBitForBit) {
+  SceneSession whole(scene(), quiet());
+  for (int i = 0; i < 40; ++i) whole.advance();
+  // The patch holds a dent now: its history is non-empty.
+  size_t saved = 0;
+  for (const std::vector<double>& v : saved_caches(whole)) saved += v.size();
+  ASSERT_GT(saved, 0u) << "the probe should have a patch with a displacement by now";
+  const std::string path = checkpoint_after(40, "mid_press.h5");
+
+  SceneSession resumed(scene(), quiet()), bodies_only(scene(), quiet());
+  const State state = read_state(path, resumed.simulator().model());
+  resumed.resume(state, path);
+  // The same state without the patch's history (what a checkpoint held before).
+  State without;
+  without.time = state.time;
+  without.bodies = state.bodies;
+  bodies_only.resume(without, path);
+  EXPECT_EQ(saved_caches(resumed), saved_caches(whole)) << "the restored history is the saved one, exactly";
+
+  for (int i = 0; i < 10; ++i) {
+    whole.advance();
+    resumed.advance();
+    bodies_only.advance();
+  }
+  const State& w = whole.simulator().scene_state();
+  const State& r = resumed.simulator().scene_state();
+  EXPECT_EQ(resumed.time(), whole.time());
+  EXPECT_EQ(r.bodies[0].q.z, w.bodies[0].q.z);
+  EXPECT_EQ(r.bodies[0].q_prev.z, w.bodies[0].q_prev.z);
+  EXPECT_EQ(resumed.body_surface(0), whole.body_surface(0));
+  EXPECT_EQ(saved_caches(resumed), saved_caches(whole));
+  // Without the history the dent pops: the skin differs by far more than rounding.
+  const double popped = (bodies_only.body_surface(0) - whole.body_surface(0)).cwiseAbs().maxCoeff();
+  EXPECT_GT(popped, 1e-6) << "a resume without the patch's history should not match";
+}
+
+TEST_F(CheckpointResume, BadCachesAreRefusedNamingTheFileAndTheDataset) {
+  const std::string good = checkpoint_after(40, "good.h5");
+  SceneSession s(scene(), quiet());
+  const Model& model = s.simulator().model();
+  int patch_term = -1, elastic_term = -1;
+  for (size_t j = 0; j < model.terms().size(); ++j) {
+    if (model.terms()[j].term->name() == "contact:probe") patch_term = int(j);
+    if (model.terms()[j].term->name() == "elastic") elastic_term = int(j);
+  }
+  ASSERT_GE(patch_term, 0);
+  ASSERT_GE(elastic_term, 0);
+  // A copy of the good file with the patch's cache replaced.
+  auto crafted = [&](const std::string& name, const std::string& term_name, const std::vector<double>& values,
+                     int term = -1) {
+    const io::Hdf5File in(good, io::Hdf5File::Mode::Read);
+    const std::string path = (dir_ / name).string();
+    io::Hdf5File f(path, io::Hdf5File::Mode::Write);
+    f.write_scalar("/meta/format_version", std::int64_t(kStateFormatVersion));
+    f.write_string("/meta/kind", "sflsh state");
+    f.write_scalar("/state/time", in.read_scalar("/state/time"));
+    f.write_strings("/state/bodies", in.read_strings("/state/bodies"));
+    for (const char* d : {"bones", "bones_prev"}) f.write_matrix(std::string("/state/0/") + d, in.read_matrix(std::string("/state/0/") + d));
+    for (const char* d : {"z", "z_prev"}) {
+      const std::vector<double> v = in.read_nd(std::string("/state/0/") + d, {-1});
+      f.write_nd(std::string("/state/0/") + d, v.data(), {std::int64_t(v.size())});
+    }
+    const int j = term >= 0 ? term : patch_term;
+    f.write_nd("/state/caches/terms", &j, {1});
+    const std::string g = "/state/caches/" + std::to_string(j) + "/";
+    f.write_string(g + "name", term_name);
+    f.write_nd(g + "values", values.data(), {std::int64_t(values.size())});
+    f.commit();
+    return path;
+  };
+  std::vector<double> one_node(13, 0.0);
+  one_node[0] = 5;
+  // The good file's values read back into a crafted copy resume (the helper is sound).
+  const io::Hdf5File in(good, io::Hdf5File::Mode::Read);
+  const std::string g = "/state/caches/" + std::to_string(patch_term) + "/values";
+  ASSERT_TRUE(in.has(g));
+  EXPECT_NO_THROW(read_state(crafted("same.h5", "contact:probe", in.read_nd(g, {-1})), model));
+
+  const std::string renamed = crafted("renamed.h5", "contact:other", one_node);
+  test::expect_error([&] { read_state(renamed, model); }, {renamed, "name is 'contact:other'", "contact:probe"});
+  std::vector<double> fourteen(14, 0.0);
+  const std::string short_row = crafted("short_row.h5", "contact:probe", fourteen);
+  test::expect_error([&] { read_state(short_row, model); }, {short_row, "values", "not a multiple of 13"});
+  std::vector<double> far = one_node;
+  far[0] = 1e6;
+  const std::string far_node = crafted("far_node.h5", "contact:probe", far);
+  test::expect_error([&] { read_state(far_node, model); }, {far_node, "names node 1e+06", "below"});
+  std::vector<double> nan = one_node;
+  nan[4] = std::nan("");
+  const std::string not_finite = crafted("nan.h5", "contact:probe", nan);
+  test::expect_error([&] { read_state(not_finite, model); }, {not_finite, "/values", "non-finite value at flat index 4"});
+  const std::string beyond = crafted("beyond.h5", "contact:probe", one_node, 99);
+  test::expect_error([&] { read_state(beyond, model); }, {beyond, "/state/caches/terms[0] is 99"});
+  const std::string keeps_none = crafted("elastic.h5", "elastic", one_node, elastic_term);
+  test::expect_error([&] { read_state(keeps_none, model); }, {keeps_none, "/state/caches/" + std::to_string(elastic_term) + "/values", "carries no state"});
+}
