@@ -11,7 +11,6 @@ namespace sflsh {
 
 using result_file_detail::check_scene;
 using result_file_detail::object_group;
-using result_file_detail::pose_from_row;
 using result_file_detail::pose_to_row;
 using result_file_detail::tool_group;
 

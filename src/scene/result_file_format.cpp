@@ -1,10 +1,32 @@
 #include "scene/result_file_format.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "sflsh/core/error.hpp"
 
 namespace sflsh::result_file_detail {
+namespace {
+
+constexpr const char* kShapes[] = {"plane", "sphere", "box", "capsule", "cylinder", "mesh"};
+constexpr const char* kKinds[] = {"static", "kinematic", "dynamic"};
+/// Largest |‖q‖ − 1| a stored quaternion may have (they are written normalized in float64).
+constexpr double kUnitTolerance = 1e-6;
+
+template <size_t N>
+bool one_of(const std::string& s, const char* const (&list)[N]) {
+  return std::find(std::begin(list), std::end(list), s) != std::end(list);
+}
+
+template <size_t N>
+std::string joined(const char* const (&list)[N]) {
+  std::string out;
+  for (const char* x : list) out += (out.empty() ? "" : ", ") + std::string(x);
+  return out;
+}
+
+}  // namespace
 
 void check_scene(const ResultScene& scene, Eigen::Index V, const std::string& where) {
   const auto& names = scene.body_names;

@@ -1,32 +1,13 @@
 #pragma once
 // The result file's layout shared by its writer (result_file.cpp) and reader
-// (result_file_reader.cpp): the names of object shapes and kinds, the groups,
-// the scene's checks and the 7-number pose rows.
-#include <algorithm>
+// (result_file_reader.cpp): the groups, the scene's checks and the 7-number
+// pose rows.
 #include <cstddef>
-#include <iterator>
 #include <string>
 
 #include "sflsh/scene/result_file.hpp"
 
 namespace sflsh::result_file_detail {
-
-inline constexpr const char* kShapes[] = {"plane", "sphere", "box", "capsule", "cylinder", "mesh"};
-inline constexpr const char* kKinds[] = {"static", "kinematic", "dynamic"};
-/// Largest |‖q‖ − 1| a stored quaternion may have (they are written normalized in float64).
-inline constexpr double kUnitTolerance = 1e-6;
-
-template <size_t N>
-bool one_of(const std::string& s, const char* const (&list)[N]) {
-  return std::find(std::begin(list), std::end(list), s) != std::end(list);
-}
-
-template <size_t N>
-inline std::string joined(const char* const (&list)[N]) {
-  std::string out;
-  for (const char* x : list) out += (out.empty() ? "" : ", ") + std::string(x);
-  return out;
-}
 
 inline std::string object_group(size_t o) { return "/objects/" + std::to_string(o); }
 inline std::string tool_group(size_t t) { return "/tools/" + std::to_string(t); }

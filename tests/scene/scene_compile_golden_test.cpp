@@ -2,9 +2,11 @@
 // apps/scenes/figures/*.yaml) into a session: the Model's term list (names,
 // order, bound bodies) and its DoF layout, exactly, and the State after the
 // first step and after a few more, and the tools' and objects' states, as
-// fingerprints (weighted sums of every double, distinct weights per entry)
-// within 1e-9 relative (test_support.hpp: kGoldenRelative, and why not bit
-// for bit). A refactor of how a scene is built or stepped must reproduce them.
+// fingerprints (weighted sums of every double, distinct weights per entry):
+// the first step within 1e-9 relative (test_support.hpp: kGoldenRelative, and
+// why not bit for bit), the later ones within what a run can hold on another
+// CPU (kAfterStepsRelative, kBodyContactAfterSteps). A refactor of how a
+// scene is built or stepped must reproduce them.
 //
 // Each scene is run on the small box avatar of box_avatar_fixture.hpp instead
 // of the built-in body (`avatar: default`), its body moved where the scene's
