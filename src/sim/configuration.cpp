@@ -29,4 +29,29 @@ Configuration retract(const Configuration& q, const VecX& delta, const DofLayout
   return out;
 }
 
+VecX tangent_between(const Configuration& to, const Configuration& from, const DofLayout& layout) {
+  require(to.z.size() == layout.num_reduced && from.z.size() == layout.num_reduced, "tangent_between: z has ",
+          to.z.size(), " and ", from.z.size(), " entries, expected ", layout.num_reduced);
+  VecX delta = VecX::Zero(layout.end());
+  if (layout.bones_dynamic) {
+    require(int(to.bones.size()) == layout.num_bones && int(from.bones.size()) == layout.num_bones,
+            "tangent_between: ", to.bones.size(), " and ", from.bones.size(), " bones, expected ", layout.num_bones);
+    const bool pivots = layout.bone_pivots.rows() > 0;
+    for (int i = 0; i < layout.num_bones; ++i) {
+      const Mat3 E = to.bones[i].linear() * from.bones[i].linear().transpose();
+      const Vec3 w = rotation_log(E);
+      // retract: t' = E t + v (+ p − E p + ω × p about the pivot p).
+      Vec3 v = to.bones[i].translation() - E * from.bones[i].translation();
+      if (pivots) {
+        const Vec3 p = from.bones[i] * Vec3(layout.bone_pivots.row(i).transpose());
+        v -= p - E * p + w.cross(p);
+      }
+      delta.segment<3>(layout.bone_offset(i)) = w;
+      delta.segment<3>(layout.bone_offset(i) + 3) = v;
+    }
+  }
+  delta.segment(layout.z_offset(), layout.num_reduced) = to.z - from.z;
+  return delta;
+}
+
 }  // namespace sflsh

@@ -176,6 +176,80 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
   }
 }
 
+/// The patch's δu the term reports at q (its "patch_displacement", by node).
+std::map<int, Vec3> reported_patch(const ContactPatchTerm& term, const StepContext& ctx, const Configuration& q) {
+  std::map<int, Vec3> du;
+  for (const TermQuantity& r : term.report(ctx, q))
+    if (r.name == "patch_displacement")
+      for (Eigen::Index i = 0; i + 3 < r.value.size(); i += 4)
+        du[int(r.value[i])] = Vec3(r.value[i + 1], r.value[i + 2], r.value[i + 3]);
+  return du;
+}
+
+double patch_distance(const std::map<int, Vec3>& a, const std::map<int, Vec3>& b) {
+  double d2 = 0;
+  for (const auto& [n, u] : a) d2 += (u - b.at(n)).squaredNorm();
+  return std::sqrt(d2);
+}
+
+TEST(ContactPatch, ATrialTakesTheBorderedNewtonStepsPatchDisplacement) {
+  // A Newton iteration minimizes δu at its start q0; its trials q0 ⊕ αΔ take
+  // δu from the bordered system's back-substitution, δu0 − Φ_pp⁻¹ Φ_pq Δ,
+  // not from a new minimization. Against the minimizer at the trial, that is
+  // first-order exact: its error falls about four-fold when Δ halves (3.6
+  // here), while δu itself moves linearly. With the cross block the Schur
+  // complement takes (the subspace's small-strain K0, not the dented tets'
+  // K1) or its guarded Φ_pp, the error was first order (a ratio of 2) and a
+  // third of the move. With bones dynamic the bones' rows are approximate
+  // (δu's rotation with them is not differentiated): a ratio of 3.0.
+  const Avatar a = slab(6);
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - 0.001, -0.003);
+  ContactPatchOptions o;
+  o.pressure_stiffness = 2.0e7;
+  o.spacing = 0.003;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-14;
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false, o);
+  for (bool dynamic : {false, true}) {
+    StepContext ctx = context(a, &frames, dynamic);
+    Configuration q0 = ctx.q_prev;
+    for (int i = 0; i < q0.z.size(); ++i) q0.z[i] = 0.0004 * std::sin(1.7 * i + 0.3);
+    const int n = ctx.layout.size();
+    VecX step = VecX::Zero(n);
+    for (int i = 0; i < n; ++i) step[i] = 0.0006 * std::cos(0.9 * i + 0.2);  // m in z; rad and m for the bones
+    double last_error = 0;
+    for (double alpha : {1.0, 0.5}) {
+      const Configuration q1 = retract(q0, alpha * step, ctx.layout);
+      // The minimizer at q1: a fresh step asked for the Hessian there.
+      const auto fresh = begin_term_step(term, ctx);
+      MatX H = MatX::Zero(n, n);
+      term.evaluate(ctx, q1, nullptr, &H);
+      const std::map<int, Vec3> minimizer = reported_patch(term, ctx, q1);
+      // The iteration from q0 and its trial at q1.
+      const auto cache = begin_term_step(term, ctx);
+      H.setZero();
+      term.evaluate(ctx, q0, nullptr, &H);
+      const std::map<int, Vec3> at_start = reported_patch(term, ctx, q0);
+      const double E_trial = term.evaluate(ctx, q1, nullptr, nullptr);
+      const std::map<int, Vec3> trial = reported_patch(term, ctx, q1);
+      ASSERT_EQ(trial.size(), minimizer.size());
+      ASSERT_FALSE(trial.empty());
+      const double moved = patch_distance(minimizer, at_start), error = patch_distance(trial, minimizer);
+      EXPECT_GT(moved, 1e-7) << "the step should move the patch";
+      EXPECT_LT(error, 0.05 * moved) << "bones dynamic " << dynamic << ", α " << alpha;
+      // Not minimized: the trial's energy is at or above the minimum there.
+      const auto again = begin_term_step(term, ctx);
+      EXPECT_GE(E_trial, term.evaluate(ctx, q1, nullptr, nullptr) - 1e-12 * std::abs(E_trial));
+      if (alpha == 0.5) {
+        EXPECT_GT(last_error / error, dynamic ? 2.5 : 3.2) << "bones dynamic " << dynamic << ": errors " << last_error << ", " << error;
+        EXPECT_LT(last_error / error, 5.5) << "bones dynamic " << dynamic << ": errors " << last_error << ", " << error;
+      }
+      last_error = error;
+    }
+  }
+}
+
 TEST(ContactPatch, WhatThePatchSubtractsIsWhatTheSubspaceHolds) {
   // The patch subtracts each tet's share of the subspace's elastic energy.
   // With mean dilatation the subspace holds only α = 0.2 of each tet's own

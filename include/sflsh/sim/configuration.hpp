@@ -54,4 +54,9 @@ struct DofLayout {
 /// least layout.end() entries; this body's are [layout.base, layout.end()).
 Configuration retract(const Configuration& q, const VecX& delta, const DofLayout& layout);
 
+/// The tangent step that retract() turns `from` into `to` with: retract(from,
+/// tangent_between(to, from, layout), layout) = to (each bone's relative
+/// rotation below π). Returns layout.end() entries, zero before layout.base.
+VecX tangent_between(const Configuration& to, const Configuration& from, const DofLayout& layout);
+
 }  // namespace sflsh

@@ -372,7 +372,9 @@ bool ContactPatchTerm::active(const StepContext& ctx) const {
 }
 
 double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
-  const VecX du = minimize_patch(ctx, q);
+  // A Newton iteration's start (asked for the Hessian) minimizes the patch
+  // out; its trials take δu from the bordered system (step_patch).
+  const VecX du = hess ? minimize_patch(ctx, q) : step_patch(ctx, q);
   Evaluation ev;
   EvaluationMode mode;
   mode.q_derivatives = grad || hess;
@@ -410,11 +412,12 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   Eigen::LLT<MatX> guarded;
   if (relaxed) guarded.compute(ev.Hpp + ev.K0pp);
   require(!relaxed || guarded.info() == Eigen::Success, name(), ": the patch's guarded Hessian is not positive definite");
-  const DofLayout& L = local_layout(ctx);
   c.linearized = true;
-  c.z_lin = q.z;
-  c.du_lin = du;
-  c.Hpz = ev.Hqp.middleRows(L.z_offset(), L.num_reduced).transpose();
+  c.q_lin = q;
+  if (dynamic_) c.object_lin = *ctx.bound[1].q;
+  c.Hpq = ev.Hqp.transpose();  // with the dented tets' own stiffness (the complement takes K0's)
+  c.Hpq.middleCols(local_layout(ctx).z_offset(), ev.Hzp_stiffening.rows()) += ev.Hzp_stiffening.transpose();
+  c.du_lin = du - llt.solve(ev.gp);
   const MatX X = (relaxed ? guarded : llt).matrixL().solve(Hc);
   MatX S = MatX::Zero(X.cols(), X.cols());  // XᵀX, its lower half
   S.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());

@@ -21,6 +21,7 @@ struct ContactPatchTerm::Evaluation {
   VecX gq;   // ∂Φ/∂q
   MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
   MatX Hqp;  // cross block (layout rows by patch DoFs)
+  MatX Hzp_stiffening;  // what the dented tets' stiffness adds to Hqp's z rows: Wᵀ (K1 − K0), by patch DoFs
   MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q Hessian)
   Vec3 force = Vec3::Zero();
   Vec3 point_sum = Vec3::Zero();  // Σ |f_s| x_s over the touching samples (world, m·N)
@@ -86,13 +87,15 @@ struct PatchCache : TermCache {
   VecX du_predicted;                           // the step's first start: 2 δu(t) − δu(t − h)
   int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
   // The configuration `du` minimizes Φ at (skipped when asked again), and the
-  // linearization of the last Hessian evaluation: δu(z) ≈ du_lin − Φ_pp⁻¹ Φ_pz (z − z_lin).
+  // linearization of the last Hessian evaluation (at the body's q_lin and a
+  // dynamic object's object_lin): δu(q) ≈ du_lin − Φ_pp⁻¹ Φ_pq (q ⊖ q_lin).
   bool solved = false;
   Configuration q_solved;
   Isometry object_solved = Isometry::Identity();
   bool linearized = false;
-  VecX z_lin, du_lin;
-  MatX Hpz;                     // Φ_pz (patch DoFs by z)
+  Configuration q_lin, object_lin;
+  VecX du_lin;
+  MatX Hpq;                     // Φ_pq (patch DoFs by the term's layout)
   Eigen::LLT<MatX> Hpp_llt;
   std::map<int, PatchHistory> history;  // ordered: the patch's slots and a checkpoint do not depend on hashing
   // The step's anchors (PatchAnchors), by increasing vertex: the tool point at

@@ -83,6 +83,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   if (q_hessian) {
     out.Hqq = MatX::Zero(nq, nq);
     out.Hqp = MatX::Zero(nq, np);
+    out.Hzp_stiffening = MatX::Zero(L.num_reduced, np);
     out.K0pp = MatX::Zero(np, np);
   }
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
@@ -195,6 +196,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   // taken through W once per node after the loop.
   std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());
   std::vector<Mat3> node_cross(q_hessian ? c.cross_slot.size() : 0, Mat3::Zero());  // per (node, slot) pair
+  std::vector<Mat3> node_stiffening(node_cross.size(), Mat3::Zero());                  // K1 − K0, the same pairs
   double E = 0;
   for (size_t ti = 0; ti < c.tets.size(); ++ti) {
     const int t = c.tets[ti];
@@ -241,7 +243,11 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
       node_grad[size_t(local[k])] += V * ((P1 - P0) * gk);
       if (!q_hessian) continue;
       for (int l = 0; l < 4; ++l)
-        if (slot[l] >= 0) node_cross[size_t(c.tet_cross[ti][size_t(4 * k + l)])] += K0[k][l];
+        if (slot[l] >= 0) {
+          const size_t e = size_t(c.tet_cross[ti][size_t(4 * k + l)]);
+          node_cross[e] += K0[k][l];
+          node_stiffening[e] += K[k][l] - K0[k][l];
+        }
     }
   }
   if (q_derivatives)
@@ -252,8 +258,11 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
         const int row = z0 + 3 * int(it.col());
         out.gq.segment<3>(row) += it.value() * node_grad[i];
         if (!q_hessian) continue;
-        for (int e = c.cross_first[i]; e < c.cross_first[i + 1]; ++e)
+        for (int e = c.cross_first[i]; e < c.cross_first[i + 1]; ++e) {
           out.Hqp.block<3, 3>(row, 3 * long(c.cross_slot[size_t(e)])) += it.value() * node_cross[size_t(e)];
+          out.Hzp_stiffening.block<3, 3>(row - z0, 3 * long(c.cross_slot[size_t(e)])) +=
+              it.value() * node_stiffening[size_t(e)];
+        }
       }
     }
   if (q_hessian)  // the bulk share, constant over the step (prepare_bulk_hessian)

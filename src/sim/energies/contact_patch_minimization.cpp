@@ -9,6 +9,7 @@
 
 namespace sflsh {
 
+using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
 
@@ -21,19 +22,46 @@ bool same_configuration(const Configuration& a, const Configuration& b) {
 }
 }  // namespace
 
+bool ContactPatchTerm::patch_solved_at(const StepContext& ctx, const Configuration& q) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+  return c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix();
+}
+
+VecX ContactPatchTerm::linearized_patch(const StepContext& ctx, const Configuration& q) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  const DofLayout& L = local_layout(ctx);
+  VecX dq = VecX::Zero(c.Hpq.cols());
+  dq.head(L.end()) += tangent_between(q, c.q_lin, L);
+  if (dynamic_) {
+    const DofLayout& O = ctx.bound[1].layout;
+    dq.head(O.end()) += tangent_between(*ctx.bound[1].q, c.object_lin, O);
+  }
+  return c.du_lin - c.Hpp_llt.solve(c.Hpq * dq);
+}
+
+VecX ContactPatchTerm::step_patch(const StepContext& ctx, const Configuration& q) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  if (c.du.size() == 0 || c.releasing || !c.linearized || patch_solved_at(ctx, q)) return minimize_patch(ctx, q);
+  VecX du = linearized_patch(ctx, q);
+  // Where it would crush a patch tet (Φ = +inf), the minimizer instead.
+  for (double det : patch_tet_determinants(c, q.z, du))
+    if (!(det > 0)) return minimize_patch(ctx, q);
+  return du;
+}
+
 VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
   PatchCache& c = patch_cache(ctx, name());
   if (c.du.size() == 0 || c.releasing) return c.du;  // released: δu prescribed (begin_step)
   // The integrator evaluates the final configuration several times (trial,
   // report): the minimizer is kept.
+  if (patch_solved_at(ctx, q)) return c.du;
   const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
-  if (c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix()) return c.du;
   // The step's first start: δu extrapolated from its last two steps (a dent
   // that deepens keeps deepening); then the last linearization's
-  // back-substitution of the bordered Newton system for the change of z (the
-  // bones' change is left out).
+  // back-substitution of the bordered Newton system.
   VecX du = !c.solved && c.du_predicted.size() == c.du.size() ? c.du_predicted : c.du;
-  if (c.linearized && c.z_lin.size() == q.z.size()) du = c.du_lin - c.Hpp_llt.solve(c.Hpz * (q.z - c.z_lin));
+  if (c.linearized) du = linearized_patch(ctx, q);
   Evaluation ev, trial;
   ++c.minimizations;
   EvaluationMode exact, energy_only;

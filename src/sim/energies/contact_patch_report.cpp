@@ -14,7 +14,7 @@ using contact_patch_detail::PatchHistory;
 
 std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const Configuration& q) const {
   PatchCache& c = patch_cache(ctx, name());
-  const VecX du = minimize_patch(ctx, q);
+  VecX du = step_patch(ctx, q);
   Evaluation ev;
   EvaluationMode mode;
   mode.p_derivatives = false;

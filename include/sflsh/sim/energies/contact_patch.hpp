@@ -62,6 +62,16 @@
 // (compute), and A_n held at the iterate's bones (δu's rotation with the
 // bones is not differentiated).
 //
+// Trials: δu is minimized at each Newton iteration's start q0 only. The
+// iteration's trials q0 ⊕ Δ (the line search's, and the step's end when it
+// is accepted) take the back-substitution of the bordered system,
+// δu0 − Φ_pp⁻¹ (Φ_p + Φ_pq Δ), with the exact Φ_pp and the dented tets' own
+// cross block Wᵀ K1 (not the complement's guarded blocks): first-order
+// exact, so a trial's energy is that of (q, δu) one Newton step from the
+// minimum, and the next iteration or step minimizes again from there. The
+// minimizer instead where the back-substitution would crush a patch tet.
+// (Minimized at every trial, each step paid for a second inner Newton.)
+//
 // Limit: with the patch covering every Simulated node, the elastic cubature
 // exact per tet and the inertia lumped at the nodes, E(q) is the full FEM's
 // energy of u = Wz + δu minimized over δu, plus the remainder at W z, which
@@ -72,8 +82,9 @@
 // Life of a patch: begin_step selects the candidate faces (a vertex within
 // reach of the object at time t) and the patch nodes (Simulated nodes within
 // patch_radius of a near vertex, plus every node whose δu is still above
-// release_displacement). The displacement at t + h is the minimizer at the
-// step's final q, fixed when the integrator asks for the report. When no
+// release_displacement). The displacement at t + h is the one at the
+// step's final q (its last trial's, above), fixed when the integrator asks
+// for the report. When no
 // skin is near the object (and no anchor holds), the patch is released: δu
 // is no longer minimized but prescribed, decaying as exp(−t/release_time)
 // (δu(t + h) = e^(−h/τ) δu(t)), and a node leaves once its δu is below
@@ -237,6 +248,16 @@ class ContactPatchTerm : public EnergyTerm {
 
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
   VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
+  /// δu at a Newton iteration's trial q: the bordered system's
+  /// back-substitution from the iteration's start (linearized_patch), so
+  /// that bones, handles and patch take one Newton step together; the
+  /// minimizer where there is no linearization, q is its own, or the
+  /// back-substitution would crush a patch tet.
+  VecX step_patch(const StepContext& ctx, const Configuration& q) const;
+  /// δu_lin − Φ_pp⁻¹ Φ_pq (q ⊖ q_lin), the last Hessian evaluation's linearization.
+  VecX linearized_patch(const StepContext& ctx, const Configuration& q) const;
+  /// Whether the cache's δu minimizes Φ at q (and the object's pose).
+  bool patch_solved_at(const StepContext& ctx, const Configuration& q) const;
   /// The share of tet `t` in the quadratic part of the body's elastic term,
   /// per unit volume at F (J/m³; H2 the tet's small-strain Hessian), with its
   /// stress P and its constant Hessian H (the stiffness the cross block Φ_zp
