@@ -75,6 +75,10 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
       if (a.tet.elements(t, c) == n) at_nodes.barycentric(n, c) = 1.0;
   }
   nodes_ = PosedPoints::at_cubature(a, at_nodes);
+  for (int n = 0; n < N; ++n)
+    if (a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated))
+      simulated_by_x_.emplace_back(a.tet.nodes(n, 0), n);
+  std::sort(simulated_by_x_.begin(), simulated_by_x_.end());
   grads_ = fem::tet_gradients(a.tet);
   tet_volume_ = fem::tet_volumes(a.tet);
   node_mass_ = VecX::Zero(N);
@@ -180,8 +184,9 @@ void ContactPatchTerm::select_patch_nodes(TermCache& cache, const std::vector<in
       // plus that vertex's φ: the deepest contact's nodes first when the patch
       // is over max_patch_nodes (a broad press).
       std::vector<std::pair<double, int>> ranked;
-      for (int n = 0; n < a.tet.num_nodes(); ++n) {
-        if (a.node_role.size() && a.node_role[n] != int(NodeRole::Simulated)) continue;
+      const auto first = std::lower_bound(simulated_by_x_.begin(), simulated_by_x_.end(), std::make_pair(lo.x(), -1));
+      for (auto it = first; it != simulated_by_x_.end() && it->first <= hi.x(); ++it) {
+        const int n = it->second;
         const Vec3 y = a.tet.nodes.row(n).transpose();
         if ((y.array() < lo.array()).any() || (y.array() > hi.array()).any()) continue;
         double rank = std::numeric_limits<double>::infinity();
@@ -210,6 +215,8 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
   std::sort(c.nodes.begin(), c.nodes.end());
   c.node_slot.clear();
   for (int i = 0; i < int(c.nodes.size()); ++i) c.node_slot[c.nodes[i]] = i;
+  if (c.nodes == c.prepared_nodes) return;  // the tets, slots and pairs below follow from the nodes alone
+  c.prepared_nodes = c.nodes;
   std::vector<char> tet_mark(a.tet.num_elements(), 0);
   c.tets.clear();
   for (int n : c.nodes)
@@ -345,6 +352,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   c.du_predicted = VecX::Zero(3 * P);
   c.inner_iterations = c.minimizations = 0;
   c.solved = c.linearized = false;
+  c.has_trial = false;
   for (size_t i = 0; i < P; ++i) {
     const int n = c.nodes[i];
     const Vec3 xt = nodes_.world_point(n, qt);
@@ -381,10 +389,22 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   mode.q_hessian = hess != nullptr;
   mode.p_derivatives = hess != nullptr;
   const double E = evaluate_patch(ctx, q, du, mode, ev);
-  if (!std::isfinite(E) || (!grad && !hess)) return E;
   PatchCache& c = patch_cache(ctx, name());
+  if (!hess) {  // a trial: kept for the report, which asks at the accepted one
+    c.trial_q = q;
+    c.trial_object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+    c.trial_du = du;
+    c.has_trial = true;
+  }
+  if (!std::isfinite(E) || (!grad && !hess)) {
+    if (!hess) c.trial = std::move(ev);
+    return E;
+  }
   if (grad) *grad += ev.gq;
-  if (!hess) return E;
+  if (!hess) {
+    c.trial = std::move(ev);
+    return E;
+  }
   *hess += ev.Hqq;
   if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
   // Schur complement over the rows of the layout the patch touches.

@@ -64,6 +64,7 @@ struct PatchCache : TermCache {
   std::vector<int> nodes;                      // patch nodes
   std::unordered_map<int, int> node_slot;      // node → index into `nodes`
   std::vector<int> tets;                       // tets with a patch node
+  std::vector<int> prepared_nodes;             // the (sorted) nodes `tets` and what follows were prepared for
   // Per patch tet (`tets` order): its nodes as indices into `tet_nodes`, their
   // patch slots (−1: not a patch node), and the material's small-strain Hessian.
   std::vector<int> tet_nodes;                  // distinct nodes of the patch tets
@@ -97,6 +98,12 @@ struct PatchCache : TermCache {
   VecX du_lin;
   MatX Hpq;                     // Φ_pq (patch DoFs by the term's layout)
   Eigen::LLT<MatX> Hpp_llt;
+  // The step's last trial: its configuration, δu and evaluation.
+  bool has_trial = false;
+  Configuration trial_q;
+  Isometry trial_object = Isometry::Identity();
+  VecX trial_du;
+  ContactPatchTerm::Evaluation trial;
   std::map<int, PatchHistory> history;  // ordered: the patch's slots and a checkpoint do not depend on hashing
   // The step's anchors (PatchAnchors), by increasing vertex: the tool point at
   // t + h and at t, and the vertex (with its patch offset) at t; step frame.

@@ -14,11 +14,22 @@ using contact_patch_detail::PatchHistory;
 
 std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const Configuration& q) const {
   PatchCache& c = patch_cache(ctx, name());
-  VecX du = step_patch(ctx, q);
-  Evaluation ev;
-  EvaluationMode mode;
-  mode.p_derivatives = false;
-  evaluate_patch(ctx, q, du, mode, ev);
+  const VecX du = step_patch(ctx, q);
+  // The accepted trial's evaluation when the report is at it (as after a
+  // step: q and δu are the last trial's), else one of its own.
+  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+  const bool at_trial = c.has_trial && c.trial_du.size() == du.size() && c.trial_du == du &&
+                        c.trial_q.z.size() == q.z.size() && c.trial_q.z == q.z &&
+                        object.matrix() == c.trial_object.matrix() && c.trial_q.bones.size() == q.bones.size() &&
+                        std::equal(q.bones.begin(), q.bones.end(), c.trial_q.bones.begin(),
+                                   [](const Isometry& a, const Isometry& b) { return a.matrix() == b.matrix(); });
+  Evaluation own;
+  if (!at_trial) {
+    EvaluationMode mode;
+    mode.p_derivatives = false;
+    evaluate_patch(ctx, q, du, mode, own);
+  }
+  const Evaluation& ev = at_trial ? c.trial : own;
   double max_du = 0;
   VecX packed(4 * c.nodes.size());
   for (size_t i = 0; i < c.nodes.size(); ++i) {

@@ -310,6 +310,7 @@ class ContactPatchTerm : public EnergyTerm {
   std::vector<int> sample_node_;   // their main node
   std::vector<MaterialPoint> materials_;
   std::vector<std::vector<int>> node_tets_;    // tets of each node
+  std::vector<std::pair<double, int>> simulated_by_x_;  // (unposed x, node) of the Simulated nodes, increasing
   std::vector<std::vector<int>> vertex_faces_;  // skin faces of each vertex
   struct VertexCluster {
     int bone = 0;
