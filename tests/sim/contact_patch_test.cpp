@@ -176,6 +176,16 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
   }
 }
 
+/// The patch options of a 1.2 cm ball on the slab, minimized to round-off.
+ContactPatchOptions ball_options() {
+  ContactPatchOptions o;
+  o.pressure_stiffness = 2.0e7;
+  o.spacing = 0.003;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-14;
+  return o;
+}
+
 /// The patch's δu the term reports at q (its "patch_displacement", by node).
 std::map<int, Vec3> reported_patch(const ContactPatchTerm& term, const StepContext& ctx, const Configuration& q) {
   std::map<int, Vec3> du;
@@ -205,11 +215,7 @@ TEST(ContactPatch, ATrialTakesTheBorderedNewtonStepsPatchDisplacement) {
   const Avatar a = slab(6);
   std::map<std::string, WorldFrame> frames;
   frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - 0.001, -0.003);
-  ContactPatchOptions o;
-  o.pressure_stiffness = 2.0e7;
-  o.spacing = 0.003;
-  o.patch_radius = 0.015;
-  o.inner_tolerance = 1e-14;
+  const ContactPatchOptions o = ball_options();
   const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false, o);
   for (bool dynamic : {false, true}) {
     StepContext ctx = context(a, &frames, dynamic);
@@ -674,11 +680,7 @@ TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFinit
   // The slab (bones kinematic, 6 handles) and a ball as a rigid body bound
   // second: the term's local system is [z (18) | ball (6)].
   const Avatar a = slab(6);
-  ContactPatchOptions o;
-  o.pressure_stiffness = 2.0e7;
-  o.spacing = 0.003;
-  o.patch_radius = 0.015;
-  o.inner_tolerance = 1e-14;
+  const ContactPatchOptions o = ball_options();
   const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), true, o);
   for (bool dynamic_bones : {false, true}) {
   SCOPED_TRACE(dynamic_bones ? "bones dynamic" : "bones kinematic");
