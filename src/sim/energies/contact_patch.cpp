@@ -391,20 +391,16 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   const double E = evaluate_patch(ctx, q, du, mode, ev);
   PatchCache& c = patch_cache(ctx, name());
   if (!hess) {  // a trial: kept for the report, which asks at the accepted one
+    if (grad && std::isfinite(E)) *grad += ev.gq;
     c.trial_q = q;
     c.trial_object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
     c.trial_du = du;
-    c.has_trial = true;
-  }
-  if (!std::isfinite(E) || (!grad && !hess)) {
-    if (!hess) c.trial = std::move(ev);
-    return E;
-  }
-  if (grad) *grad += ev.gq;
-  if (!hess) {
     c.trial = std::move(ev);
+    c.has_trial = true;
     return E;
   }
+  if (!std::isfinite(E)) return E;
+  if (grad) *grad += ev.gq;
   *hess += ev.Hqq;
   if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
   // Schur complement over the rows of the layout the patch touches.

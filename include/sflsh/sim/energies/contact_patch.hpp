@@ -65,7 +65,7 @@
 // Trials: δu is minimized at each Newton iteration's start q0 only. The
 // iteration's trials q0 ⊕ Δ (the line search's, and the step's end when it
 // is accepted) take the back-substitution of the bordered system,
-// δu0 − Φ_pp⁻¹ (Φ_p + Φ_pq Δ), with the exact Φ_pp and the dented tets' own
+// δu0 − Φ_pp⁻¹ (Φ_p + Φ_pq Δ), with Φ_pp itself and the dented tets' own
 // cross block Wᵀ K1 (not the complement's guarded blocks): first-order
 // exact, so a trial's energy is that of (q, δu) one Newton step from the
 // minimum, and the next iteration or step minimizes again from there. The
