@@ -393,7 +393,7 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   if (!hess) {  // a trial: kept for the report, which asks at the accepted one
     if (grad && std::isfinite(E)) *grad += ev.gq;
     c.trial_q = q;
-    c.trial_object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+    c.trial_object = object_pose(ctx);
     c.trial_du = du;
     c.trial = std::move(ev);
     c.has_trial = true;

@@ -22,10 +22,18 @@ bool same_configuration(const Configuration& a, const Configuration& b) {
 }
 }  // namespace
 
+Isometry ContactPatchTerm::object_pose(const StepContext& ctx) const {
+  return dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+}
+
+bool ContactPatchTerm::at_configuration(const StepContext& ctx, const Configuration& q, const Configuration& seen,
+                                        const Isometry& object_seen) const {
+  return same_configuration(q, seen) && object_pose(ctx).matrix() == object_seen.matrix();
+}
+
 bool ContactPatchTerm::patch_solved_at(const StepContext& ctx, const Configuration& q) const {
   const PatchCache& c = patch_cache(ctx, name());
-  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
-  return c.solved && same_configuration(q, c.q_solved) && object.matrix() == c.object_solved.matrix();
+  return c.solved && at_configuration(ctx, q, c.q_solved, c.object_solved);
 }
 
 VecX ContactPatchTerm::linearized_patch(const StepContext& ctx, const Configuration& q) const {
@@ -56,7 +64,7 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // The integrator evaluates the final configuration several times (trial,
   // report): the minimizer is kept.
   if (patch_solved_at(ctx, q)) return c.du;
-  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
+  const Isometry object = object_pose(ctx);
   // The step's first start: δu extrapolated from its last two steps (a dent
   // that deepens keeps deepening); then the last linearization's
   // back-substitution of the bordered Newton system.

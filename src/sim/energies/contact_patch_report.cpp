@@ -17,12 +17,8 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
   const VecX du = step_patch(ctx, q);
   // The accepted trial's evaluation when the report is at it (as after a
   // step: q and δu are the last trial's), else one of its own.
-  const Isometry object = dynamic_ ? ctx.bound[1].q->bones[0] : Isometry::Identity();
   const bool at_trial = c.has_trial && c.trial_du.size() == du.size() && c.trial_du == du &&
-                        c.trial_q.z.size() == q.z.size() && c.trial_q.z == q.z &&
-                        object.matrix() == c.trial_object.matrix() && c.trial_q.bones.size() == q.bones.size() &&
-                        std::equal(q.bones.begin(), q.bones.end(), c.trial_q.bones.begin(),
-                                   [](const Isometry& a, const Isometry& b) { return a.matrix() == b.matrix(); });
+                        at_configuration(ctx, q, c.trial_q, c.trial_object);
   Evaluation own;
   if (!at_trial) {
     EvaluationMode mode;

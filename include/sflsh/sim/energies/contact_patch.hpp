@@ -258,6 +258,11 @@ class ContactPatchTerm : public EnergyTerm {
   VecX linearized_patch(const StepContext& ctx, const Configuration& q) const;
   /// Whether the cache's δu minimizes Φ at q (and the object's pose).
   bool patch_solved_at(const StepContext& ctx, const Configuration& q) const;
+  /// The dynamic object's pose at the iterate (identity for a static or kinematic one).
+  Isometry object_pose(const StepContext& ctx) const;
+  /// Whether q and the object's pose are bit for bit `seen` and `object_seen`.
+  bool at_configuration(const StepContext& ctx, const Configuration& q, const Configuration& seen,
+                        const Isometry& object_seen) const;
   /// The share of tet `t` in the quadratic part of the body's elastic term,
   /// per unit volume at F (J/m³; H2 the tet's small-strain Hessian), with its
   /// stress P and its constant Hessian H (the stiffness the cross block Φ_zp
