@@ -72,8 +72,8 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
   require(f.has("/meta/kind") && f.read_string("/meta/kind") == "sflsh state", path,
           ": not an sflsh state file (/meta/kind is missing or not \"sflsh state\")");
   const double version = f.read_scalar("/meta/format_version");
-  require(version == 1 || version == kStateFormatVersion, path, ": /meta/format_version is ", version,
-          ", expected 1 to ", kStateFormatVersion);
+  require(version == 1 || version == 2 || version == kStateFormatVersion, path, ": /meta/format_version is ",
+          version, ", expected 1 to ", kStateFormatVersion);
   const std::vector<std::string> names = f.read_strings("/state/bodies");
   require(names.size() == model.bodies().size(), path, ": /state/bodies has ", names.size(),
           " bodies, the scene has ", model.bodies().size());
@@ -100,6 +100,9 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
     fail(path, ": ", e.what());
   }
   if (!f.has("/state/caches/terms")) return s;
+  require(version == kStateFormatVersion, path, ": /meta/format_version is ", version,
+          ": its term caches (the contact patch's history) are in an older layout; write the checkpoint again "
+          "with this sflsh (sflsh simulate ... --checkpoint)");
   const auto terms = f.read_int_matrix("/state/caches/terms", -1, 1);
   for (Eigen::Index k = 0; k < terms.rows(); ++k) {
     const int j = terms(k, 0);

@@ -114,11 +114,11 @@ TEST_F(CheckpointResume, BadCachesAreRefusedNamingTheFileAndTheDataset) {
   ASSERT_GE(elastic_term, 0);
   // A copy of the good file with the patch's cache replaced.
   auto crafted = [&](const std::string& name, const std::string& term_name, const std::vector<double>& values,
-                     int term = -1) {
+                     int term = -1, int version = kStateFormatVersion) {
     const io::Hdf5File in(good, io::Hdf5File::Mode::Read);
     const std::string path = (dir_ / name).string();
     io::Hdf5File f(path, io::Hdf5File::Mode::Write);
-    f.write_scalar("/meta/format_version", std::int64_t(kStateFormatVersion));
+    f.write_scalar("/meta/format_version", std::int64_t(version));
     f.write_string("/meta/kind", "sflsh state");
     f.write_scalar("/state/time", in.read_scalar("/state/time"));
     f.write_strings("/state/bodies", in.read_strings("/state/bodies"));
@@ -135,7 +135,7 @@ TEST_F(CheckpointResume, BadCachesAreRefusedNamingTheFileAndTheDataset) {
     f.commit();
     return path;
   };
-  std::vector<double> one_node(13, 0.0);
+  std::vector<double> one_node(16, 0.0);  // a node, then δu, d_t, δu_next, d_next, du_back_next
   one_node[0] = 5;
   // The good file's values read back into a crafted copy resume (the helper is sound).
   const io::Hdf5File in(good, io::Hdf5File::Mode::Read);
@@ -145,9 +145,14 @@ TEST_F(CheckpointResume, BadCachesAreRefusedNamingTheFileAndTheDataset) {
 
   const std::string renamed = crafted("renamed.h5", "contact:other", one_node);
   test::expect_error([&] { read_state(renamed, model); }, {renamed, "name is 'contact:other'", "contact:probe"});
-  std::vector<double> fourteen(14, 0.0);
-  const std::string short_row = crafted("short_row.h5", "contact:probe", fourteen);
-  test::expect_error([&] { read_state(short_row, model); }, {short_row, "values", "not a multiple of 13"});
+  std::vector<double> seventeen(17, 0.0);
+  const std::string short_row = crafted("short_row.h5", "contact:probe", seventeen);
+  test::expect_error([&] { read_state(short_row, model); }, {short_row, "values", "not a multiple of 16"});
+  // Format 2 kept 13 values per node: its caches are refused, even when their count would parse.
+  std::vector<double> sixteen_old_nodes(13 * 16, 0.0);
+  for (int i = 0; i < 16; ++i) sixteen_old_nodes[size_t(13 * i)] = i;
+  const std::string old_layout = crafted("format2.h5", "contact:probe", sixteen_old_nodes, -1, 2);
+  test::expect_error([&] { read_state(old_layout, model); }, {old_layout, "format_version is 2", "older layout"});
   std::vector<double> far = one_node;
   far[0] = 1e6;
   const std::string far_node = crafted("far_node.h5", "contact:probe", far);

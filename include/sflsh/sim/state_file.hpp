@@ -3,7 +3,9 @@
 // and resume bit-identically (`sflsh simulate --checkpoint F` / `--resume F`).
 //
 // Layout (names fixed; SI units):
-//   /meta/format_version   2 (1: without /state/caches; read as well)
+//   /meta/format_version   3 (1: without /state/caches, read as well; 2: the
+//                          contact patch's history without du_back_next, read
+//                          when it holds no cache, else refused naming the version)
 //   /meta/kind             "sflsh state"
 //   /state/time            s
 //   /state/bodies          (B,) body names, in model order
@@ -23,7 +25,7 @@
 
 namespace sflsh {
 
-inline constexpr int kStateFormatVersion = 2;
+inline constexpr int kStateFormatVersion = 3;
 
 /// Writes `state` of `model` to `path` (atomically: NAME.partial, then renamed).
 void write_state(const std::string& path, const Model& model, const State& state);

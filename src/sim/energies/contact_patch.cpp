@@ -320,6 +320,8 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     h.d_t = h.d_next;
     h.du_prev = h.du;
     h.du = h.du_next;
+    h.du_back = h.du_back_next;
+    h.du_back_next.setZero();
     const double rel = options_.release_displacement;
     if (h.du.norm() <= rel && h.d_t.norm() <= rel && h.d_prev.norm() <= rel) {
       left.emplace(it->first, h);
@@ -353,15 +355,19 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
   c.inner_iterations = c.minimizations = 0;
   c.solved = c.linearized = false;
   c.has_trial = false;
+  c.settled = P > 0;
   for (size_t i = 0; i < P; ++i) {
     const int n = c.nodes[i];
     const Vec3 xt = nodes_.world_point(n, qt);
     c.x_star[i] = has_prev ? Vec3(2 * xt - nodes_.world_point(n, *b.q_prev2)) : xt;
     const auto h = c.history.find(n);
-    if (h == c.history.end()) continue;
+    if (h == c.history.end()) {
+      c.settled = false;
+      continue;
+    }
     c.d_pred[i] = 2 * h->second.d_t - h->second.d_prev;
     c.du.segment<3>(3 * i) = h->second.du;
-    c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev;
+    c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev + h->second.du_back;
   }
   if (c.releasing) c.du *= decay;
   c.samples_in_patch.clear();
@@ -382,20 +388,22 @@ bool ContactPatchTerm::active(const StepContext& ctx) const {
 double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const {
   // A Newton iteration's start (asked for the Hessian) minimizes the patch
   // out; its trials take δu from the bordered system (step_patch).
-  const VecX du = hess ? minimize_patch(ctx, q) : step_patch(ctx, q);
-  Evaluation ev;
+  PatchCache& c = patch_cache(ctx, name());
+  // A trial's evaluation is kept for the report, which asks at the accepted one.
+  Evaluation& ev = hess ? c.start : c.trial;
+  bool evaluated = false;  // by minimize_patch, at a warm start that minimized Φ
+  const VecX du = hess ? minimize_patch(ctx, q, &ev, &evaluated) : step_patch(ctx, q);
   EvaluationMode mode;
   mode.q_derivatives = grad || hess;
   mode.q_hessian = hess != nullptr;
   mode.p_derivatives = hess != nullptr;
-  const double E = evaluate_patch(ctx, q, du, mode, ev);
-  PatchCache& c = patch_cache(ctx, name());
-  if (!hess) {  // a trial: kept for the report, which asks at the accepted one
+  if (!hess) c.has_trial = false;
+  const double E = evaluated ? ev.energy : evaluate_patch(ctx, q, du, mode, ev);
+  if (!hess) {
     if (grad && std::isfinite(E)) *grad += ev.gq;
     c.trial_q = q;
     c.trial_object = object_pose(ctx);
     c.trial_du = du;
-    c.trial = std::move(ev);
     c.has_trial = true;
     return E;
   }
@@ -404,14 +412,21 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   *hess += ev.Hqq;
   if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
   // Schur complement over the rows of the layout the patch touches.
+  std::vector<char> touched(size_t(ev.Hqp.rows()), 0);
+  for (int j = 0; j < ev.Hqp.cols(); ++j)
+    for (int r = 0; r < ev.Hqp.rows(); ++r)
+      if (ev.Hqp(r, j) != 0) touched[size_t(r)] = 1;
   std::vector<int> rows;
   for (int r = 0; r < ev.Hqp.rows(); ++r)
-    if (ev.Hqp.row(r).squaredNorm() > 0) rows.push_back(r);
+    if (touched[size_t(r)]) rows.push_back(r);
   if (rows.empty()) return E;
   MatX Hc(ev.Hqp.cols(), int(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
   Eigen::LLT<MatX>& llt = c.Hpp_llt;
-  llt.compute(ev.Hpp);
+  if (evaluated)
+    std::swap(llt, c.start_llt);
+  else
+    llt.compute(ev.Hpp);
   require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
   // The complement must stay below what the other terms carry for these DoFs
   // (Wᵀ K0 W over the patch tets, the nodes' inertia, the contact): by the
@@ -422,18 +437,23 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   // diagonal shift makes it positive definite): Φ_pp + K0_pp is used instead,
   // which is ⪰ K0_pp + M + C because K1 is PSD-projected. Only the Hessian
   // changes; in the first case it is as before.
-  Eigen::LLT<MatX> below(ev.Hpp - ev.K0pp + MatX::Identity(ev.Hpp.rows(), ev.Hpp.cols()) *
-                                                (1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff()));
+  Eigen::LLT<MatX>&below = c.below_llt, &guarded = c.guarded_llt;
+  below.compute(ev.Hpp - ev.K0pp + MatX::Identity(ev.Hpp.rows(), ev.Hpp.cols()) *
+                                       (1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff()));
   const bool relaxed = below.info() != Eigen::Success;
-  Eigen::LLT<MatX> guarded;
   if (relaxed) guarded.compute(ev.Hpp + ev.K0pp);
   require(!relaxed || guarded.info() == Eigen::Success, name(), ": the patch's guarded Hessian is not positive definite");
   c.linearized = true;
   c.q_lin = q;
   if (dynamic_) c.object_lin = *ctx.bound[1].q;
-  c.Hpq = ev.Hqp.transpose();  // with the dented tets' own stiffness (the complement takes K0's)
-  c.Hpq.middleCols(local_layout(ctx).z_offset(), ev.Hzp_stiffening.rows()) += ev.Hzp_stiffening.transpose();
-  c.du_lin = du - llt.solve(ev.gp);
+  const VecX rest = llt.solve(ev.gp);  // Φ_pp⁻¹ Φ_p: what δu has left to its minimizer (inner_tolerance)
+  c.du_lin = du - rest;
+  // The bordered system's right-hand side: Φ_q − Φ_qp Φ_pp⁻¹ Φ_p (Φ_qp with the dented tets' own stiffness).
+  if (grad) {
+    const int z0 = local_layout(ctx).z_offset();
+    *grad -= ev.Hqp * rest;
+    grad->segment(z0, ev.Hzp_stiffening.rows()) -= ev.Hzp_stiffening * rest;
+  }
   const MatX X = (relaxed ? guarded : llt).matrixL().solve(Hc);
   MatX S = MatX::Zero(X.cols(), X.cols());  // XᵀX, its lower half
   S.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
@@ -442,6 +462,10 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
       (*hess)(rows[k], rows[l]) -= S(int(k), int(l));
       if (k != l) (*hess)(rows[l], rows[k]) -= S(int(k), int(l));
     }
+  // Kept for the trials: Φ_pq with the dented tets' own stiffness (the complement takes K0's).
+  c.Hqp.swap(ev.Hqp);  // the evaluation gets the last linearization's storage back
+  c.Hzp_stiffening.swap(ev.Hzp_stiffening);
+  c.z_lin = local_layout(ctx).z_offset();
   return E;
 }
 

@@ -16,6 +16,7 @@ namespace sflsh {
 /// node, cache order) and the term's local layout q.
 struct ContactPatchTerm::Evaluation {
   double energy = 0;
+  double subspace_share = 0;  // what `energy` holds of −Σ V Ψ(F(Wz)) and the samples' inertia (constant in δu)
   VecX gp;   // ∂Φ/∂δu
   MatX Hpp;  // its PSD approximation
   VecX gq;   // ∂Φ/∂q
@@ -41,16 +42,22 @@ struct PatchHistory {
   Vec3 d_prev = Vec3::Zero();   // at t − h
   Vec3 du_next = Vec3::Zero();  // fixed by report() for t + h
   Vec3 d_next = Vec3::Zero();
+  // The step's start extrapolates δu to t + h, 2 δu(t) − δu(t − h), but starts
+  // the other DoFs at q(t) (kinematic bones: at t + h): du_back takes their
+  // move over the last step back, Φ_pp⁻¹ Φ_pq (q(t) ⊖ q(t − h)) at that step's
+  // last linearization (zero without one); report() fixes du_back_next.
+  Vec3 du_back = Vec3::Zero();
+  Vec3 du_back_next = Vec3::Zero();
 };
 
 /// Doubles per node in PatchCache::saved_state.
-inline constexpr size_t kPatchHistoryValues = 13;
+inline constexpr size_t kPatchHistoryValues = 16;
 
 struct PatchCache : TermCache {
   /// The patch's displacement and its history are state (δu and its velocity carry over).
   std::unique_ptr<TermCache> clone() const override { return std::make_unique<PatchCache>(*this); }
-  /// The history, per node in increasing order: the node, then δu, d_t, δu_next
-  /// and d_next (kPatchHistoryValues each): what begin_step reads of it.
+  /// The history, per node in increasing order: the node, then δu, d_t, δu_next,
+  /// d_next and du_back_next (kPatchHistoryValues each): what begin_step reads of it.
   std::vector<double> saved_state() const override;
   void restore_state(const std::vector<double>& values, const std::string& where) override;
   int num_nodes = 0;  // the avatar's tet nodes (a restored node must be one)
@@ -85,7 +92,8 @@ struct PatchCache : TermCache {
   std::vector<Vec3> sample_x_star;             // their predictions
   bool releasing = false;                      // no contact: δu prescribed (decaying), not minimized
   VecX du;                                     // last minimizer (3 per patch node)
-  VecX du_predicted;                           // the step's first start: 2 δu(t) − δu(t − h)
+  VecX du_predicted;                           // the step's first start: 2 δu(t) − δu(t − h) + du_back
+  bool settled = false;                        // every patch node was in the last step's patch
   int inner_iterations = 0, minimizations = 0; // this step's Newton iterations on δu, and minimizations
   // The configuration `du` minimizes Φ at (skipped when asked again), and the
   // linearization of the last Hessian evaluation (at the body's q_lin and a
@@ -96,8 +104,21 @@ struct PatchCache : TermCache {
   bool linearized = false;
   Configuration q_lin, object_lin;
   VecX du_lin;
-  MatX Hpq;                     // Φ_pq (patch DoFs by the term's layout)
+  // Φ_pq = Hqpᵀ + the dented tets' stiffening of its z columns (z_lin: their offset).
+  MatX Hqp, Hzp_stiffening;
+  int z_lin = 0;
   Eigen::LLT<MatX> Hpp_llt;
+  Eigen::LLT<MatX> start_llt;  // Φ_pp's factor at a Newton iteration's start (minimize_patch)
+  /// Φ_pp⁻¹ Φ_pq dq at the last linearization (dq over the term's layout).
+  VecX linear_response(const VecX& dq) const {
+    VecX b = Hqp.transpose() * dq;
+    b.noalias() += Hzp_stiffening.transpose() * dq.segment(z_lin, Hzp_stiffening.rows());
+    return Hpp_llt.solve(b);
+  }
+  // Evaluations kept for their storage (evaluate_patch resets them in place):
+  // a Newton iteration's start, and the inner Newton iteration's point and trial.
+  ContactPatchTerm::Evaluation start, inner, inner_trial;
+  Eigen::LLT<MatX> below_llt, guarded_llt;  // the complement's guard (compute)
   // The step's last trial: its configuration, δu and evaluation.
   bool has_trial = false;
   Configuration trial_q;

@@ -76,15 +76,23 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   const DofLayout& L = local_layout(ctx);
   const int ob = object_offset(ctx);  // the object's 6 DoFs in the term's system, or −1
   const int nq = std::max(L.end(), ob + 6), np = int(du.size());
+  // Reset in place: the blocks keep their storage from the last evaluation
+  // into `out` (a patch's blocks are a few hundred kB, and fresh pages cost
+  // more than zeroing them).
+  VecX gp = std::move(out.gp), gq = std::move(out.gq);
+  MatX Hpp = std::move(out.Hpp), Hqq = std::move(out.Hqq), Hqp = std::move(out.Hqp);
+  MatX Hzp = std::move(out.Hzp_stiffening), K0pp = std::move(out.K0pp);
   out = Evaluation();
-  out.gp = VecX::Zero(np);
-  out.Hpp = MatX::Zero(np, np);
-  if (q_derivatives) out.gq = VecX::Zero(nq);
+  out.gp = std::move(gp);
+  out.gp.setZero(np);
+  out.Hpp = std::move(Hpp);
+  out.Hpp.setZero(np, np);
+  if (q_derivatives) (out.gq = std::move(gq)).setZero(nq);
   if (q_hessian) {
-    out.Hqq = MatX::Zero(nq, nq);
-    out.Hqp = MatX::Zero(nq, np);
-    out.Hzp_stiffening = MatX::Zero(L.num_reduced, np);
-    out.K0pp = MatX::Zero(np, np);
+    (out.Hqq = std::move(Hqq)).setZero(nq, nq);
+    (out.Hqp = std::move(Hqp)).setZero(nq, np);
+    (out.Hzp_stiffening = std::move(Hzp)).setZero(L.num_reduced, np);
+    (out.K0pp = std::move(K0pp)).setZero(np, np);
   }
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
   const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);
@@ -141,7 +149,9 @@ double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configu
       const int s = c.samples_in_patch[k];
       const double m = inertia_mass_[s];
       const Vec3 r = inertia_points_.world_point(s, q) - c.sample_x_star[k];
-      E -= 0.5 * m * inv_h2 * r.squaredNorm();
+      const double share = 0.5 * m * inv_h2 * r.squaredNorm();
+      E -= share;
+      out.subspace_share -= share;
       if (!q_derivatives) continue;
       inertia_points_.local_jacobian(s, q, L, J, cols);
       const Vec3 gr = m * inv_h2 * r;
@@ -218,7 +228,11 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
     E += V * psi1;
     // The subspace's quadratic share of the tet: constant while δu varies (left out then).
     const Mat9& H2 = c.tet_H2[ti];
-    if (subspace) E -= V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
+    if (subspace) {
+      const double share = V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
+      E -= share;
+      out.subspace_share -= share;
+    }
     if (!p_derivatives) continue;
     const ElementBlocks K = element_blocks(grads_[t], V, H1);
     // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken as the subspace's own

@@ -39,13 +39,13 @@ bool ContactPatchTerm::patch_solved_at(const StepContext& ctx, const Configurati
 VecX ContactPatchTerm::linearized_patch(const StepContext& ctx, const Configuration& q) const {
   const PatchCache& c = patch_cache(ctx, name());
   const DofLayout& L = local_layout(ctx);
-  VecX dq = VecX::Zero(c.Hpq.cols());
+  VecX dq = VecX::Zero(c.Hqp.rows());
   dq.head(L.end()) += tangent_between(q, c.q_lin, L);
   if (dynamic_) {
     const DofLayout& O = ctx.bound[1].layout;
     dq.head(O.end()) += tangent_between(*ctx.bound[1].q, c.object_lin, O);
   }
-  return c.du_lin - c.Hpp_llt.solve(c.Hpq * dq);
+  return c.du_lin - c.linear_response(dq);
 }
 
 VecX ContactPatchTerm::step_patch(const StepContext& ctx, const Configuration& q) const {
@@ -58,8 +58,10 @@ VecX ContactPatchTerm::step_patch(const StepContext& ctx, const Configuration& q
   return du;
 }
 
-VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q) const {
+VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuration& q, Evaluation* start,
+                                      bool* at_start) const {
   PatchCache& c = patch_cache(ctx, name());
+  if (at_start) *at_start = false;
   if (c.du.size() == 0 || c.releasing) return c.du;  // released: δu prescribed (begin_step)
   // The integrator evaluates the final configuration several times (trial,
   // report): the minimizer is kept.
@@ -70,17 +72,39 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
   // back-substitution of the bordered Newton system.
   VecX du = !c.solved && c.du_predicted.size() == c.du.size() ? c.du_predicted : c.du;
   if (c.linearized) du = linearized_patch(ctx, q);
-  Evaluation ev, trial;
+  Evaluation &ev = c.inner, &trial = c.inner_trial;
   ++c.minimizations;
   EvaluationMode exact, energy_only;
   exact.project = false;
   exact.subspace_energy = false;
   energy_only.p_derivatives = false;
   energy_only.subspace_energy = false;
+  // A Newton iteration's start (`start`) needs the evaluation at the minimizer
+  // with q's derivatives and the projected Φ_pp. When the warm start is likely
+  // a minimizer (every patch node was in the last step's patch) it is
+  // evaluated so first: when its Newton step with that Φ_pp moves no node by
+  // more than the tolerance, it is the minimizer, and `*start` and
+  // c.start_llt (Φ_pp's factor) hold what the iteration needs. Otherwise the
+  // Newton iteration below runs.
+  if (start && c.settled) {
+    EvaluationMode full;
+    full.q_derivatives = full.q_hessian = true;
+    const double E = evaluate_patch(ctx, q, du, full, *start);
+    if (std::isfinite(E)) c.start_llt.compute(start->Hpp);
+    if (std::isfinite(E) && c.start_llt.info() == Eigen::Success &&
+        (start->gp.norm() < 1e-12 || c.start_llt.solve(start->gp).cwiseAbs().maxCoeff() <= options_.inner_tolerance)) {
+      c.du = du;
+      c.solved = true;
+      c.q_solved = q;
+      c.object_solved = object;
+      *at_start = true;
+      return du;
+    }
+  }
   // Newton on δu: the exact element Hessians (quadratic convergence) unless
   // compression makes them indefinite, then their PSD majorizers; Armijo
-  // backtracking; stops when the Newton decrement −gᵀs falls below
-  // inner_tolerance × |Φ| (or the gradient vanishes).
+  // backtracking; stops when the Newton step s moves no node by more than
+  // inner_tolerance (or the gradient vanishes).
   // The start: the lower energy of the warm start and the last minimizer (a
   // warm start predicted past a tet's collapse starts the Newton iteration
   // far up the compression barrier, where it gains only a constant factor
@@ -116,8 +140,8 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
       }
     }
     const VecX step = llt.solve(-ev.gp);
-    const double slope = ev.gp.dot(step), scale = std::max(std::abs(E0), 1e-12);
-    if (-slope <= options_.inner_tolerance * scale) break;
+    if (step.cwiseAbs().maxCoeff() <= options_.inner_tolerance) break;
+    const double slope = ev.gp.dot(step);
     double alpha = 1, E1 = E0;
     bool ok = false;
     for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {

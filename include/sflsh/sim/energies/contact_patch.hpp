@@ -72,6 +72,18 @@
 // minimizer instead where the back-substitution would crush a patch tet.
 // (Minimized at every trial, each step paid for a second inner Newton.)
 //
+// Inner minimization: Newton on δu until its step moves no node by more than
+// inner_tolerance (µm against mm dents). What is left, Φ_pp⁻¹ Φ_p, enters the
+// step through the bordered system's right-hand side: the iteration's
+// gradient is Φ_q − Φ_qp Φ_pp⁻¹ Φ_p, the gradient of the energy its trials
+// see. The step's start extrapolates δu from its last two steps and takes
+// back what the other DoFs' move over the last step contributed to it
+// (PatchHistory::du_back, carried in checkpoints); when every patch node has
+// such a history, that start is evaluated with the q derivatives the
+// iteration needs and, already within the tolerance (most steps of a probe
+// or a slow press), it is used as is: one evaluation and one factorization
+// of Φ_pp per Newton iteration.
+//
 // Limit: with the patch covering every Simulated node, the elastic cubature
 // exact per tet and the inertia lumped at the nodes, E(q) is the full FEM's
 // energy of u = Wz + δu minimized over δu, plus the remainder at W z, which
@@ -149,8 +161,11 @@ struct ContactPatchOptions {
   /// its motion and the object's over the step.
   double margin = 0.005;
   int max_inner_iterations = 30;  ///< Newton iterations on δu per evaluation
-  /// They end when the Newton decrement −gᵀs (J) is below this share of |Φ|.
-  double inner_tolerance = 1e-9;
+  /// m: they end when the Newton step s moves no patch node by more than this
+  /// (‖s‖∞). The step's bordered Newton system then takes the rest of Φ's
+  /// gradient in δu along (its right-hand side holds it), so δu need not be
+  /// converged further: a probe's 10 mm dent moves by a few µm per step.
+  double inner_tolerance = 1e-5;
   double release_displacement = 1e-6;  ///< m: a node leaves the patch once |δu| is below this
   /// s (> 0): out of contact, δu decays with this time constant (header comment, "Life of a patch").
   double release_time = 0.02;
@@ -247,7 +262,10 @@ class ContactPatchTerm : public EnergyTerm {
                        std::vector<double>& seed_phi) const;
 
   /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
-  VecX minimize_patch(const StepContext& ctx, const Configuration& q) const;
+  /// With `start`: a Newton iteration's start, whose evaluation (with q's
+  /// derivatives) is in `*start` when `*at_start` (the warm start minimized Φ).
+  VecX minimize_patch(const StepContext& ctx, const Configuration& q, Evaluation* start = nullptr,
+                      bool* at_start = nullptr) const;
   /// δu at a Newton iteration's trial q: the bordered system's
   /// back-substitution from the iteration's start (linearized_patch), so
   /// that bones, handles and patch take one Newton step together; the
