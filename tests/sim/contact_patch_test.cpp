@@ -63,6 +63,22 @@ double quantity(const std::vector<TermQuantity>& r, const std::string& name, int
   return NAN;
 }
 
+/// Central differences (step 1e-7) of the term's energy at q over the body's layout.
+VecX energy_gradient_fd(const ContactPatchTerm& term, const StepContext& ctx, const Configuration& q) {
+  const int n = ctx.layout.size();
+  VecX fd(n);
+  const double eps = 1e-7;
+  for (int i = 0; i < n; ++i) {
+    VecX d = VecX::Zero(n);
+    d[i] = eps;
+    const double Ep = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
+    d[i] = -eps;
+    const double Em = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
+    fd[i] = (Ep - Em) / (2 * eps);
+  }
+  return fd;
+}
+
 TEST(ContactPatch, UniformPenetrationGivesPressureStiffnessTimesDepthTimesArea) {
   // The slab's skin reduced to its top face (y = 3 cm, 6 cm × 4 cm), and a
   // half-space whose surface is 0.7 mm below it: every sample is 0.7 mm deep,
@@ -135,16 +151,7 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
     VecX g = VecX::Zero(n);
     const double E = term.evaluate(ctx, q, &g, nullptr);
     ASSERT_GT(E, 0);
-    VecX fd(n);
-    const double eps = 1e-7;
-    for (int i = 0; i < n; ++i) {
-      VecX d = VecX::Zero(n);
-      d[i] = eps;
-      const double Ep = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-      d[i] = -eps;
-      const double Em = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-      fd[i] = (Ep - Em) / (2 * eps);
-    }
+    const VecX fd = energy_gradient_fd(term, ctx, q);
     EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "bones dynamic " << dynamic << ", " << press << " m: |g| " << g.norm()
                                                   << ", |fd| " << fd.norm();
     // The gradient asked with the Hessian (the Newton iteration) is the one
@@ -282,16 +289,7 @@ TEST(ContactPatch, AnUnconvergedPatchEntersTheStepThroughTheBorderedRightHandSid
   MatX H = MatX::Zero(n, n);
   term.evaluate(ctx, q0, &g, &H);
   term.evaluate(ctx, q0, &g_at_start, nullptr);  // Φ_q at (q0, δu0)
-  VecX fd(n);
-  const double eps = 1e-7;
-  for (int i = 0; i < n; ++i) {
-    VecX d = VecX::Zero(n);
-    d[i] = eps;
-    const double Ep = term.evaluate(ctx, retract(q0, d, ctx.layout), nullptr, nullptr);
-    d[i] = -eps;
-    const double Em = term.evaluate(ctx, retract(q0, d, ctx.layout), nullptr, nullptr);
-    fd[i] = (Ep - Em) / (2 * eps);
-  }
+  const VecX fd = energy_gradient_fd(term, ctx, q0);
   const double error = (g - fd).norm(), without = (g_at_start - fd).norm();
   EXPECT_GT(without, 1e-3 * fd.norm()) << "the inner minimization should stop short here";
   EXPECT_LT(error, 0.05 * without) << "|g − ∇f| " << error << ", without the Φ_p term " << without << ", |∇f| " << fd.norm();
