@@ -16,7 +16,6 @@ namespace sflsh {
 /// node, cache order) and the term's local layout q.
 struct ContactPatchTerm::Evaluation {
   double energy = 0;
-  double subspace_share = 0;  // what `energy` holds of −Σ V Ψ(F(Wz)) and the samples' inertia (constant in δu)
   VecX gp;   // ∂Φ/∂δu
   MatX Hpp;  // its PSD approximation
   VecX gq;   // ∂Φ/∂q

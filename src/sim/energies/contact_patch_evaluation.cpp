@@ -149,9 +149,7 @@ double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configu
       const int s = c.samples_in_patch[k];
       const double m = inertia_mass_[s];
       const Vec3 r = inertia_points_.world_point(s, q) - c.sample_x_star[k];
-      const double share = 0.5 * m * inv_h2 * r.squaredNorm();
-      E -= share;
-      out.subspace_share -= share;
+      E -= 0.5 * m * inv_h2 * r.squaredNorm();
       if (!q_derivatives) continue;
       inertia_points_.local_jacobian(s, q, L, J, cols);
       const Vec3 gr = m * inv_h2 * r;
@@ -228,11 +226,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
     E += V * psi1;
     // The subspace's quadratic share of the tet: constant while δu varies (left out then).
     const Mat9& H2 = c.tet_H2[ti];
-    if (subspace) {
-      const double share = V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
-      E -= share;
-      out.subspace_share -= share;
-    }
+    if (subspace) E -= V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
     if (!p_derivatives) continue;
     const ElementBlocks K = element_blocks(grads_[t], V, H1);
     // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken as the subspace's own

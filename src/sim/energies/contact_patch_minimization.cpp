@@ -36,16 +36,23 @@ bool ContactPatchTerm::patch_solved_at(const StepContext& ctx, const Configurati
   return c.solved && at_configuration(ctx, q, c.q_solved, c.object_solved);
 }
 
-VecX ContactPatchTerm::linearized_patch(const StepContext& ctx, const Configuration& q) const {
+VecX ContactPatchTerm::move_between(const StepContext& ctx, const Configuration& q, const Configuration& q_from,
+                                    const Configuration* object, const Configuration* object_from) const {
   const PatchCache& c = patch_cache(ctx, name());
   const DofLayout& L = local_layout(ctx);
   VecX dq = VecX::Zero(c.Hqp.rows());
-  dq.head(L.end()) += tangent_between(q, c.q_lin, L);
+  dq.head(L.end()) += tangent_between(q, q_from, L);
   if (dynamic_) {
     const DofLayout& O = ctx.bound[1].layout;
-    dq.head(O.end()) += tangent_between(*ctx.bound[1].q, c.object_lin, O);
+    dq.head(O.end()) += tangent_between(*object, *object_from, O);
   }
-  return c.du_lin - c.linear_response(dq);
+  return dq;
+}
+
+VecX ContactPatchTerm::linearized_patch(const StepContext& ctx, const Configuration& q) const {
+  const PatchCache& c = patch_cache(ctx, name());
+  const Configuration* object = dynamic_ ? ctx.bound[1].q : nullptr;
+  return c.du_lin - c.linear_response(move_between(ctx, q, c.q_lin, object, &c.object_lin));
 }
 
 VecX ContactPatchTerm::step_patch(const StepContext& ctx, const Configuration& q) const {

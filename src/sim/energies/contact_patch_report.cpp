@@ -8,7 +8,6 @@
 
 namespace sflsh {
 
-using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
 using contact_patch_detail::PatchHistory;
@@ -39,16 +38,9 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
   }
   // What the next step's start takes back of its extrapolation (PatchHistory::du_back).
   if (c.linearized && !c.releasing && c.Hpp_llt.rows() == du.size()) {
-    const BoundBody& b = ctx.bound.empty() ? BoundBody{0, 0, ctx.avatar, ctx.layout, nullptr, &ctx.q_prev, nullptr}
-                                           : ctx.bound[0];
-    const DofLayout& L = local_layout(ctx);
-    VecX dq = VecX::Zero(c.Hqp.rows());
-    dq.head(L.end()) += tangent_between(q, *b.q_prev, L);
-    if (dynamic_) {
-      const BoundBody& o = ctx.bound[1];
-      dq.head(o.layout.end()) += tangent_between(*o.q, *o.q_prev, o.layout);
-    }
-    const VecX back = c.linear_response(dq);
+    const Configuration& q_t = ctx.bound.empty() ? ctx.q_prev : *ctx.bound[0].q_prev;
+    const BoundBody* o = dynamic_ ? &ctx.bound[1] : nullptr;
+    const VecX back = c.linear_response(move_between(ctx, q, q_t, o ? o->q : nullptr, o ? o->q_prev : nullptr));
     for (size_t i = 0; i < c.nodes.size(); ++i) c.history[c.nodes[i]].du_back_next = back.segment<3>(3 * long(i));
   }
   std::vector<TermQuantity> out = {{"force", "N", ev.force},

@@ -261,7 +261,8 @@ class ContactPatchTerm : public EnergyTerm {
   void collect_anchors(const StepContext& ctx, TermCache& cache, std::vector<int>& seeds,
                        std::vector<double>& seed_phi) const;
 
-  /// Minimizes Φ over δu at q (warm start: the cache's last minimizer); returns the minimizer.
+  /// Minimizes Φ over δu at q (warm start: the step's prediction, then the last
+  /// linearization's back-substitution); returns the minimizer.
   /// With `start`: a Newton iteration's start, whose evaluation (with q's
   /// derivatives) is in `*start` when `*at_start` (the warm start minimized Φ).
   VecX minimize_patch(const StepContext& ctx, const Configuration& q, Evaluation* start = nullptr,
@@ -274,6 +275,9 @@ class ContactPatchTerm : public EnergyTerm {
   VecX step_patch(const StepContext& ctx, const Configuration& q) const;
   /// δu_lin − Φ_pp⁻¹ Φ_pq (q ⊖ q_lin), the last Hessian evaluation's linearization.
   VecX linearized_patch(const StepContext& ctx, const Configuration& q) const;
+  /// q ⊖ q_from over the term's layout, with a dynamic object's object ⊖ object_from.
+  VecX move_between(const StepContext& ctx, const Configuration& q, const Configuration& q_from,
+                    const Configuration* object, const Configuration* object_from) const;
   /// Whether the cache's δu minimizes Φ at q (and the object's pose).
   bool patch_solved_at(const StepContext& ctx, const Configuration& q) const;
   /// The dynamic object's pose at the iterate (identity for a static or kinematic one).
