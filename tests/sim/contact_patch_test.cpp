@@ -295,6 +295,47 @@ TEST(ContactPatch, AnUnconvergedPatchEntersTheStepThroughTheBorderedRightHandSid
   EXPECT_LT(error, 0.05 * without) << "|g − ∇f| " << error << ", without the Φ_p term " << without << ", |∇f| " << fd.norm();
 }
 
+TEST(ContactPatch, TheNextStepsStartTakesBackTheLastStepsMove) {
+  // A step starts z at q(t) but extrapolates δu to t + h; du_back takes the
+  // last step's move q(t) ⊖ q(t − h) back through its linearization,
+  // Φ_pp⁻¹ Φ_pq (q1 ⊖ q0). To first order that is minus the change of the
+  // minimizer, −(δu*(q1) − δu*(q0)), each minimizer found afresh. The value
+  // is read where a checkpoint keeps it (saved_state: a node, then δu, d_t,
+  // δu_next, d_next and du_back_next).
+  const Avatar a = slab(6);
+  std::map<std::string, WorldFrame> frames;
+  frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - 0.001, -0.003);
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false,
+                              ball_options());
+  StepContext ctx = context(a, &frames, false);
+  for (int i = 0; i < ctx.q_prev.z.size(); ++i) ctx.q_prev.z[i] = 0.0004 * std::sin(1.7 * i + 0.3);
+  const Configuration q0 = ctx.q_prev;
+  VecX step = VecX::Zero(ctx.layout.size());
+  for (int i = 0; i < step.size(); ++i) step[i] = 0.0002 * std::cos(0.9 * i + 0.2);
+  const Configuration q1 = retract(q0, step, ctx.layout);
+  MatX H = MatX::Zero(step.size(), step.size());
+  const auto at_q0 = begin_term_step(term, ctx);
+  term.evaluate(ctx, q0, nullptr, &H);
+  const std::map<int, Vec3> du0 = reported_patch(term, ctx, q0);
+  const auto at_q1 = begin_term_step(term, ctx);
+  term.evaluate(ctx, q1, nullptr, &H);
+  const std::map<int, Vec3> du1 = reported_patch(term, ctx, q1);  // the report fixes du_back_next
+  const std::vector<double> saved = at_q1->saved_state();
+  std::map<int, Vec3> back;
+  for (size_t i = 0; i + 16 <= saved.size(); i += 16) back[int(saved[i])] = Vec3(saved[i + 13], saved[i + 14], saved[i + 15]);
+  ASSERT_EQ(du0.size(), du1.size());
+  ASSERT_FALSE(du1.empty());
+  double change2 = 0, error2 = 0;
+  for (const auto& [n, u1] : du1) {
+    ASSERT_TRUE(back.count(n)) << "node " << n << " has no saved du_back_next";
+    const Vec3 change = u1 - du0.at(n);
+    change2 += change.squaredNorm();
+    error2 += (back.at(n) + change).squaredNorm();
+  }
+  EXPECT_GT(std::sqrt(change2), 1e-7) << "the move should change the minimizer";
+  EXPECT_LT(std::sqrt(error2), 0.1 * std::sqrt(change2)) << "du_back against minus the minimizer's change";
+}
+
 TEST(ContactPatch, WhatThePatchSubtractsIsWhatTheSubspaceHolds) {
   // The patch subtracts each tet's share of the subspace's elastic energy.
   // With mean dilatation the subspace holds only α = 0.2 of each tet's own
