@@ -97,7 +97,7 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
     a.inertia.barycentric.row(s).maxCoeff(&k);
     sample_node_[size_t(s)] = a.tet.elements(a.inertia.elements[s], k);
   }
-  // The subspace's quadratic share of each tet (subspace_quadratic_density).
+  // The subspace's quadratic share of each tet (subspace_quadratic_hessian).
   if (o.subspace_mean_dilatation) dilatation_cell_ = dilatation_cells(a);
   // Broad phase: vertices by dominant bone and 10 cm cell (unposed), each
   // cluster with a bounding radius and 5 cm of slack for skinning blends and
@@ -227,6 +227,8 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
   c.tet_local.assign(c.tets.size(), {});
   c.tet_slot.assign(c.tets.size(), {});
   c.tet_H2.resize(c.tets.size());
+  c.tet_Hq.resize(c.tets.size());
+  c.tet_K0.resize(c.tets.size());
   std::unordered_map<int, int> tet_node_index;
   for (size_t i = 0; i < c.tets.size(); ++i) {
     const int t = c.tets[i];
@@ -239,6 +241,8 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
       c.tet_slot[i][size_t(k)] = s == c.node_slot.end() ? -1 : s->second;
     }
     c.tet_H2[i] = linearized_hessian(materials_[t]);
+    c.tet_Hq[i] = subspace_quadratic_hessian(t, c.tet_H2[i]);
+    c.tet_K0[i] = contact_patch_detail::element_blocks(grads_[t], tet_volume_[t], c.tet_Hq[i]);
   }
   std::vector<std::vector<int>> slots(c.tet_nodes.size());
   for (size_t i = 0; i < c.tets.size(); ++i)
@@ -422,12 +426,12 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   if (rows.empty()) return E;
   MatX Hc(ev.Hqp.cols(), int(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
-  Eigen::LLT<MatX>& llt = c.Hpp_llt;
+  contact_patch_detail::PatchCholesky& llt = c.Hpp_llt;
   if (evaluated)
     std::swap(llt, c.start_llt);
   else
-    llt.compute(ev.Hpp);
-  require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+    llt.factor(ev.Hpp);
+  require(llt.ok(), name(), ": the patch's Hessian is not positive definite");
   // The complement must stay below what the other terms carry for these DoFs
   // (Wᵀ K0 W over the patch tets, the nodes' inertia, the contact): by the
   // element-wise block argument it does when Φ_pp ⪰ K0_pp + M + C, i.e. when
@@ -437,12 +441,9 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   // diagonal shift makes it positive definite): Φ_pp + K0_pp is used instead,
   // which is ⪰ K0_pp + M + C because K1 is PSD-projected. Only the Hessian
   // changes; in the first case it is as before.
-  Eigen::LLT<MatX>&below = c.below_llt, &guarded = c.guarded_llt;
-  below.compute(ev.Hpp - ev.K0pp + MatX::Identity(ev.Hpp.rows(), ev.Hpp.cols()) *
-                                       (1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff()));
-  const bool relaxed = below.info() != Eigen::Success;
-  if (relaxed) guarded.compute(ev.Hpp + ev.K0pp);
-  require(!relaxed || guarded.info() == Eigen::Success, name(), ": the patch's guarded Hessian is not positive definite");
+  contact_patch_detail::PatchCholesky &below = c.below_llt, &guarded = c.guarded_llt;
+  const bool relaxed = !below.factor(ev.Hpp, &ev.K0pp, -1.0, 1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff());
+  require(!relaxed || guarded.factor(ev.Hpp, &ev.K0pp, 1.0), name(), ": the patch's guarded Hessian is not positive definite");
   c.linearized = true;
   c.q_lin = q;
   if (dynamic_) c.object_lin = *ctx.bound[1].q;
@@ -454,7 +455,7 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
     *grad -= ev.Hqp * rest;
     grad->segment(z0, ev.Hzp_stiffening.rows()) -= ev.Hzp_stiffening * rest;
   }
-  const MatX X = (relaxed ? guarded : llt).matrixL().solve(Hc);
+  const MatX X = (relaxed ? guarded : llt).half_solve(Hc);
   MatX S = MatX::Zero(X.cols(), X.cols());  // XᵀX, its lower half
   S.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
   for (size_t l = 0; l < rows.size(); ++l)

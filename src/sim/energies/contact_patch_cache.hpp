@@ -9,6 +9,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
+#include "sim/energies/contact_patch_cholesky.hpp"
 
 namespace sflsh {
 
@@ -33,6 +34,12 @@ struct ContactPatchTerm::Evaluation {
 };
 
 namespace contact_patch_detail {
+
+/// The 3x3 blocks K_kl = V Σ_{b,c} g_k[b] g_l[c] H_(b,c) of a tet's stiffness
+/// (g_k node k's shape gradient, H_(b,c) the 3x3 block of ∂²Ψ/∂vec(F)² that
+/// couples F's columns b and c) for a symmetric H: K_lk = K_klᵀ.
+using ElementBlocks = std::array<std::array<Mat3, 4>, 4>;
+ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, const Mat9& H);
 
 struct PatchHistory {
   Vec3 du = Vec3::Zero();       // unposed displacement at t (the fallback start)
@@ -81,6 +88,10 @@ struct PatchCache : TermCache {
   std::vector<int> cross_first, cross_slot;
   std::vector<std::array<int, 16>> tet_cross;
   std::vector<Mat9> tet_H2;
+  // Per patch tet, the subspace's quadratic share (constant): its Hessian per
+  // unit volume and its stiffness blocks over the tet's node pairs.
+  std::vector<Mat9> tet_Hq;
+  std::vector<ElementBlocks> tet_K0;
   // The bulk share mean dilatation leaves out of Φ_zz (contact_patch_evaluation.cpp,
   // elasticity) over the handles the patch tets touch: constant for a set of tets.
   std::vector<int> bulk_handles;
@@ -106,8 +117,8 @@ struct PatchCache : TermCache {
   // Φ_pq = Hqpᵀ + the dented tets' stiffening of its z columns (z_lin: their offset).
   MatX Hqp, Hzp_stiffening;
   int z_lin = 0;
-  Eigen::LLT<MatX> Hpp_llt;
-  Eigen::LLT<MatX> start_llt;  // Φ_pp's factor at a Newton iteration's start (minimize_patch)
+  PatchCholesky Hpp_llt;
+  PatchCholesky start_llt;  // Φ_pp's factor at a Newton iteration's start (minimize_patch)
   /// Φ_pp⁻¹ Φ_pq dq at the last linearization (dq over the term's layout).
   VecX linear_response(const VecX& dq) const {
     VecX b = Hqp.transpose() * dq;
@@ -117,7 +128,8 @@ struct PatchCache : TermCache {
   // Evaluations kept for their storage (evaluate_patch resets them in place):
   // a Newton iteration's start, and the inner Newton iteration's point and trial.
   ContactPatchTerm::Evaluation start, inner, inner_trial;
-  Eigen::LLT<MatX> below_llt, guarded_llt;  // the complement's guard (compute)
+  PatchCholesky below_llt, guarded_llt;  // the complement's guard (compute)
+  PatchCholesky inner_llt;               // the inner Newton iteration's Φ_pp (minimize_patch)
   // The step's last trial: its configuration, δu and evaluation.
   bool has_trial = false;
   Configuration trial_q;

@@ -16,6 +16,8 @@
 namespace sflsh {
 
 using contact_patch_detail::add_offset_rotation_gradient;
+using contact_patch_detail::element_blocks;
+using contact_patch_detail::ElementBlocks;
 using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
@@ -50,7 +52,7 @@ PatchedVertex patched_vertex(const Avatar& a, const PosedPoints& vertices, const
 }
 }  // namespace contact_patch_detail
 
-double ContactPatchTerm::subspace_quadratic_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const {
+Mat9 ContactPatchTerm::subspace_quadratic_hessian(int t, const Mat9& H2) const {
   Mat9 Hq = H2;
   if (dilatation_cell_.size() > 0 && dilatation_cell_[t] >= 0) {
     // The tet's own share of the mean-dilatation quadratic (linearized_stiffness.cpp):
@@ -62,12 +64,7 @@ double ContactPatchTerm::subspace_quadratic_density(int t, const Mat3& F, const 
     const double b = v.dot(u) / 3.0;
     Hq.noalias() -= (1.0 - kPerTetVolumeShare) * (u * v.transpose() + v * u.transpose() - b * v * v.transpose());
   }
-  const Mat3 D = F - Mat3::Identity();
-  const Vec9 h = Eigen::Map<const Vec9>(D.data());
-  const Vec9 Hqh = Hq * h;
-  if (P) *P = Eigen::Map<const Mat3>(Hqh.data());
-  if (H) *H = Hq;
-  return 0.5 * h.dot(Hqh);
+  return Hq;
 }
 
 double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du,
@@ -159,12 +156,7 @@ double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configu
   return E;
 }
 
-namespace {
-
-/// The 3x3 blocks K_kl = V Σ_{b,c} g_k[b] g_l[c] H_(b,c) of a tet's stiffness
-/// (g_k node k's shape gradient, H_(b,c) the 3x3 block of ∂²Ψ/∂vec(F)² that
-/// couples F's columns b and c) for a symmetric H: K_lk = K_klᵀ.
-using ElementBlocks = std::array<std::array<Mat3, 4>, 4>;
+namespace contact_patch_detail {
 ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, const Mat9& H) {
   std::array<Eigen::Matrix<double, 3, 9>, 4> T;  // T_k = Σ_b g_k[b] H(3b.., :)
   for (int k = 0; k < 4; ++k)
@@ -178,12 +170,11 @@ ElementBlocks element_blocks(const Eigen::Matrix<double, 4, 3>& G, double V, con
     }
   return K;
 }
-
-}  // namespace
+}  // namespace contact_patch_detail
 
 // Elasticity: the exact change δu brings to each patch tet.
 // With mean dilatation the subspace holds only α of each tet's own bulk
-// stiffness (subspace_quadratic_density), so Φ_zz gains the rest, (1 − α) κ_t V_t
+// stiffness (subspace_quadratic_hessian), so Φ_zz gains the rest, (1 − α) κ_t V_t
 // (Wᵀ b_t)(Wᵀ b_t)ᵀ with b_t the tet's volume-change gradient (κ_t = vᵀH₂v/9,
 // the rank-one bulk part of the material's small-strain Hessian): a PSD
 // Gauss–Newton part of Φ_zz that the one Newton step needs (without it the
@@ -193,6 +184,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
                                               const EvaluationMode& mode, Evaluation& out) const {
   const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
   const bool q_hessian = q_derivatives && mode.q_hessian;
+  const bool hessian = mode.p_derivatives || q_hessian;  // a gradient alone (a trial's) needs no element Hessian
   const bool subspace = mode.subspace_energy || q_derivatives;
   const PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
@@ -218,34 +210,40 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
       F1 += u1 * grads_[t].row(k);
     }
     Mat3 P0, P1;
-    Mat9 H1, H0;
+    Mat9 H1;
     const double psi1 = strain_energy_density(F1, materials_[t], p_derivatives ? &P1 : nullptr,
-                                              p_derivatives ? &H1 : nullptr, mode.project);
+                                              hessian ? &H1 : nullptr, mode.project);
     if (!std::isfinite(psi1)) return std::numeric_limits<double>::infinity();
     const double V = tet_volume_[t];
     E += V * psi1;
-    // The subspace's quadratic share of the tet: constant while δu varies (left out then).
-    const Mat9& H2 = c.tet_H2[ti];
-    if (subspace) E -= V * subspace_quadratic_density(t, F0, H2, q_derivatives ? &P0 : nullptr, q_hessian ? &H0 : nullptr);
+    // The subspace's quadratic share of the tet, ½ hᵀ H_q h with h = vec(F0 − I):
+    // constant while δu varies (left out then).
+    if (subspace) {
+      const Mat3 D = F0 - Mat3::Identity();
+      const Vec9 Hqh = c.tet_Hq[ti] * Eigen::Map<const Vec9>(D.data());
+      E -= V * (0.5 * Eigen::Map<const Vec9>(D.data()).dot(Hqh));
+      if (q_derivatives) P0 = Eigen::Map<const Mat3>(Hqh.data());
+    }
     if (!p_derivatives) continue;
-    const ElementBlocks K = element_blocks(grads_[t], V, H1);
+    ElementBlocks K;
+    if (hessian) K = element_blocks(grads_[t], V, H1);
     // The cross block Φ_zp = Wᵀ K(Wz + δu) is taken as the subspace's own
     // quadratic stiffness of the tet, Wᵀ K0: the Schur complement
     // Wᵀ K0 (K1 + M + C)⁻¹ K0 W then stays below Wᵀ K0 W, which the body's
     // elastic term carries, so the step's Hessian stays positive semi-definite
     // where the dent stiffens the tissue (K1 ≫ K0 under the Fung saturation).
     // Only the Hessian is approximated: the gradient and the energy are exact.
-    ElementBlocks K0;
-    if (q_hessian) K0 = element_blocks(grads_[t], V, H0);
+    const ElementBlocks& K0 = c.tet_K0[ti];
     for (int k = 0; k < 4; ++k) {
       const Vec3 gk = grads_[t].row(k).transpose();
       if (slot[k] >= 0) {
         out.gp.segment<3>(3 * slot[k]) += V * (P1 * gk);
-        for (int l = 0; l < 4; ++l)
-          if (slot[l] >= 0) {
-            out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
-            if (q_hessian) out.K0pp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K0[k][l];
-          }
+        if (hessian)
+          for (int l = 0; l < 4; ++l)
+            if (slot[l] >= 0) {
+              out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
+              if (q_hessian) out.K0pp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K0[k][l];
+            }
       }
       if (!q_derivatives) continue;
       node_grad[size_t(local[k])] += V * ((P1 - P0) * gk);

@@ -12,6 +12,7 @@ namespace sflsh {
 using contact_patch_detail::local_layout;
 using contact_patch_detail::patch_cache;
 using contact_patch_detail::PatchCache;
+using contact_patch_detail::PatchCholesky;
 
 namespace {
 bool same_configuration(const Configuration& a, const Configuration& b) {
@@ -97,8 +98,7 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     EvaluationMode full;
     full.q_derivatives = full.q_hessian = true;
     const double E = evaluate_patch(ctx, q, du, full, *start);
-    if (std::isfinite(E)) c.start_llt.compute(start->Hpp);
-    if (std::isfinite(E) && c.start_llt.info() == Eigen::Success &&
+    if (std::isfinite(E) && c.start_llt.factor(start->Hpp) &&
         (start->gp.norm() < 1e-12 || c.start_llt.solve(start->gp).cwiseAbs().maxCoeff() <= options_.inner_tolerance)) {
       c.du = du;
       c.solved = true;
@@ -133,17 +133,15 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     evaluated = false;
     if (!std::isfinite(E0)) break;
     if (ev.gp.norm() < 1e-12) break;
-    Eigen::LLT<MatX> llt(ev.Hpp);
-    if (llt.info() != Eigen::Success) {
+    PatchCholesky& llt = c.inner_llt;
+    if (!llt.factor(ev.Hpp)) {
       EvaluationMode projected = exact;
       projected.project = true;
       evaluate_patch(ctx, q, du, projected, ev);
-      llt.compute(ev.Hpp);
-      if (llt.info() != Eigen::Success) {
+      if (!llt.factor(ev.Hpp)) {
         // PSD by construction and PD with mass: only a degenerate tet gets here.
         ev.Hpp.diagonal() *= 1.0 + 1e-8;
-        llt.compute(ev.Hpp);
-        require(llt.info() == Eigen::Success, name(), ": the patch's Hessian is not positive definite");
+        require(llt.factor(ev.Hpp), name(), ": the patch's Hessian is not positive definite");
       }
     }
     const VecX step = llt.solve(-ev.gp);

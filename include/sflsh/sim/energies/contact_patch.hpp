@@ -285,11 +285,10 @@ class ContactPatchTerm : public EnergyTerm {
   /// Whether q and the object's pose are bit for bit `seen` and `object_seen`.
   bool at_configuration(const StepContext& ctx, const Configuration& q, const Configuration& seen,
                         const Isometry& object_seen) const;
-  /// The share of tet `t` in the quadratic part of the body's elastic term,
-  /// per unit volume at F (J/m³; H2 the tet's small-strain Hessian), with its
-  /// stress P and its constant Hessian H (the stiffness the cross block Φ_zp
-  /// takes for the tet).
-  double subspace_quadratic_density(int t, const Mat3& F, const Mat9& H2, Mat3* P, Mat9* H) const;
+  /// The constant Hessian of tet `t`'s share in the quadratic part of the
+  /// body's elastic term, per unit volume (H2 the tet's small-strain Hessian):
+  /// the stiffness the cross block Φ_zp takes for the tet.
+  Mat9 subspace_quadratic_hessian(int t, const Mat9& H2) const;
   // begin_step's parts (contact_patch.cpp), each filling the term's cache:
   /// The skin vertices near the object at t (increasing) and their φ; places the field at t + h.
   void find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
