@@ -382,6 +382,64 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
       c.samples_in_patch.push_back(s);
       c.sample_x_star.push_back(has_prev ? Vec3(2 * xt - inertia_points_.world_point(s, *b.q_prev2)) : xt);
     }
+  collect_q_rows(ctx, c, qt);
+}
+
+// The rows the evaluation writes in the q blocks: the DoFs of the points it
+// poses (the patch nodes, the inertia samples there, the candidate faces' and
+// the anchors' vertices: their Jacobians' columns), the handles of the patch
+// tets' Simulated nodes (the cross blocks through W) and of the bulk share,
+// and a dynamic object's six. Which DoFs a point depends on does not depend
+// on q, so one collection serves the step.
+void ContactPatchTerm::collect_q_rows(const StepContext& ctx, TermCache& cache, const Configuration& q) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const Avatar& a = *avatar_;
+  const DofLayout& L = local_layout(ctx);
+  // The object's rows (object_offset, without its configuration: begin_step binds t's).
+  const int ob = dynamic_ && ctx.bound.size() == 2 ? ctx.bound[1].layout.base : -1;
+  const int nq = std::max(L.end(), ob + 6), z0 = L.z_offset();
+  std::vector<char> mark(size_t(nq), 0);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J;
+  std::vector<int> cols;
+  auto add_points = [&](const PosedPoints& points, const std::vector<int>& ids) {
+    for (int p : ids) {
+      points.local_jacobian(p, q, L, J, cols);
+      for (int r : cols) mark[size_t(r)] = 1;
+    }
+  };
+  auto add_handle = [&](int h) {
+    for (int k = 0; k < 3; ++k) mark[size_t(z0 + 3 * h + k)] = 1;
+  };
+  add_points(nodes_, c.nodes);
+  add_points(inertia_points_, c.samples_in_patch);
+  add_points(vertices_, c.vertices);
+  add_points(vertices_, c.anchor_vertices);
+  for (int n : c.tet_nodes)
+    if (a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated))
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a.W, n); it; ++it) add_handle(int(it.col()));
+  for (int h : c.bulk_handles) add_handle(h);
+  if (ob >= 0)
+    for (int k = 0; k < 6; ++k) mark[size_t(ob + k)] = 1;
+  // A system of another size: every row may hold an old value (the blocks are
+  // zeroed whole when they are resized, but one of this size may be kept).
+  if (c.q_row_written.size() != size_t(nq)) {
+    c.q_row_written.assign(size_t(nq), c.q_row_written.empty() ? 0 : 1);
+    c.q_rows_written.clear();
+    for (int r = 0; r < nq; ++r)
+      if (c.q_row_written[size_t(r)]) c.q_rows_written.push_back(r);
+  }
+  c.q_rows.clear();
+  bool grew = false;
+  for (int r = 0; r < nq; ++r) {
+    if (!mark[size_t(r)]) continue;
+    c.q_rows.push_back(r);
+    if (!c.q_row_written[size_t(r)]) c.q_row_written[size_t(r)] = 1, grew = true;
+  }
+  if (grew) {
+    c.q_rows_written.clear();
+    for (int r = 0; r < nq; ++r)
+      if (c.q_row_written[size_t(r)]) c.q_rows_written.push_back(r);
+  }
 }
 
 bool ContactPatchTerm::active(const StepContext& ctx) const {
@@ -413,16 +471,17 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   }
   if (!std::isfinite(E)) return E;
   if (grad) *grad += ev.gq;
-  *hess += ev.Hqq;
+  for (int j : c.q_rows)  // Φ_qq is zero outside these rows and columns
+    for (int i : c.q_rows) (*hess)(i, j) += ev.Hqq(i, j);
   if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
   // Schur complement over the rows of the layout the patch touches.
-  std::vector<char> touched(size_t(ev.Hqp.rows()), 0);
-  for (int j = 0; j < ev.Hqp.cols(); ++j)
-    for (int r = 0; r < ev.Hqp.rows(); ++r)
-      if (ev.Hqp(r, j) != 0) touched[size_t(r)] = 1;
   std::vector<int> rows;
-  for (int r = 0; r < ev.Hqp.rows(); ++r)
-    if (touched[size_t(r)]) rows.push_back(r);
+  for (int r : c.q_rows)
+    for (int j = 0; j < ev.Hqp.cols(); ++j)
+      if (ev.Hqp(r, j) != 0) {
+        rows.push_back(r);
+        break;
+      }
   if (rows.empty()) return E;
   MatX Hc(ev.Hqp.cols(), int(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
@@ -452,8 +511,10 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   // The bordered system's right-hand side: Φ_q − Φ_qp Φ_pp⁻¹ Φ_p (Φ_qp with the dented tets' own stiffness).
   if (grad) {
     const int z0 = local_layout(ctx).z_offset();
-    *grad -= ev.Hqp * rest;
-    grad->segment(z0, ev.Hzp_stiffening.rows()) -= ev.Hzp_stiffening * rest;
+    for (int r : c.q_rows) {
+      (*grad)[r] -= ev.Hqp.row(r).dot(rest);
+      if (r >= z0 && r < z0 + ev.Hzp_stiffening.rows()) (*grad)[r] -= ev.Hzp_stiffening.row(r - z0).dot(rest);
+    }
   }
   const MatX X = (relaxed ? guarded : llt).half_solve(Hc);
   MatX S = MatX::Zero(X.cols(), X.cols());  // XᵀX, its lower half

@@ -98,6 +98,14 @@ struct PatchCache : TermCache {
   MatX bulk_hessian;
   std::vector<int> bulk_tets;  // the tets it was computed for
   std::vector<Vec3> x_star, d_pred;            // per patch node: subspace prediction, offset prediction
+  // The q blocks (Φ_qq, Φ_qp, the stiffening: nq by nq and nq by 3P, a few
+  // hundred kB, mostly zero) hold nonzeros only in the rows of the DoFs the
+  // patch's points and tets depend on: `q_rows` this step (increasing), and
+  // `q_rows_written` every row any evaluation into this cache's storage has
+  // written since it was allocated. An evaluation zeroes the latter, the
+  // condensation reads the former.
+  std::vector<int> q_rows, q_rows_written;
+  std::vector<char> q_row_written;             // per row of the system: in q_rows_written
   std::vector<int> samples_in_patch;           // inertia cubature samples whose main node is a patch node
   std::vector<Vec3> sample_x_star;             // their predictions
   bool releasing = false;                      // no contact: δu prescribed (decaying), not minimized
@@ -121,8 +129,12 @@ struct PatchCache : TermCache {
   PatchCholesky start_llt;  // Φ_pp's factor at a Newton iteration's start (minimize_patch)
   /// Φ_pp⁻¹ Φ_pq dq at the last linearization (dq over the term's layout).
   VecX linear_response(const VecX& dq) const {
-    VecX b = Hqp.transpose() * dq;
-    b.noalias() += Hzp_stiffening.transpose() * dq.segment(z_lin, Hzp_stiffening.rows());
+    VecX b = VecX::Zero(Hqp.cols());
+    for (int r : q_rows) {
+      if (dq[r] == 0) continue;
+      b.noalias() += dq[r] * Hqp.row(r).transpose();
+      if (r >= z_lin && r < z_lin + Hzp_stiffening.rows()) b.noalias() += dq[r] * Hzp_stiffening.row(r - z_lin).transpose();
+    }
     return Hpp_llt.solve(b);
   }
   // Evaluations kept for their storage (evaluate_patch resets them in place):

@@ -85,11 +85,35 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   out.Hpp = std::move(Hpp);
   out.Hpp.setZero(np, np);
   if (q_derivatives) (out.gq = std::move(gq)).setZero(nq);
+  out.Hqq = std::move(Hqq);
+  out.Hqp = std::move(Hqp);
+  out.Hzp_stiffening = std::move(Hzp);
+  out.K0pp = std::move(K0pp);
   if (q_hessian) {
-    (out.Hqq = std::move(Hqq)).setZero(nq, nq);
-    (out.Hqp = std::move(Hqp)).setZero(nq, np);
-    (out.Hzp_stiffening = std::move(Hzp)).setZero(L.num_reduced, np);
-    (out.K0pp = std::move(K0pp)).setZero(np, np);
+    // The q blocks are zero outside the rows any evaluation has written (PatchCache::q_rows_written).
+    const PatchCache& c = patch_cache(ctx, name());
+    require(c.q_row_written.size() == size_t(nq) && (ob < 0 || c.q_row_written[size_t(ob)]), name(),
+            ": the q blocks' rows were collected for another system (begin_step)");
+    const std::vector<int>& rows = c.q_rows_written;
+    const int z0 = L.z_offset();
+    if (out.Hqq.rows() != nq || out.Hqq.cols() != nq) {
+      out.Hqq.setZero(nq, nq);
+    } else {
+      for (int j : rows)
+        for (int i : rows) out.Hqq(i, j) = 0;
+    }
+    if (out.Hqp.rows() != nq || out.Hqp.cols() != np) {
+      out.Hqp.setZero(nq, np);
+    } else {
+      for (int r : rows) out.Hqp.row(r).setZero();
+    }
+    if (out.Hzp_stiffening.rows() != L.num_reduced || out.Hzp_stiffening.cols() != np) {
+      out.Hzp_stiffening.setZero(L.num_reduced, np);
+    } else {
+      for (int r : rows)
+        if (r >= z0 && r < z0 + L.num_reduced) out.Hzp_stiffening.row(r - z0).setZero();
+    }
+    out.K0pp.setZero(np, np);
   }
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
   const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);

@@ -313,6 +313,8 @@ class ContactPatchTerm : public EnergyTerm {
                              double decay) const;
   /// The bulk share of Φ_zz the patch tets add (cache's bulk_hessian), kept while they stay the same.
   void prepare_bulk_hessian(TermCache& cache) const;
+  /// The rows of the term's system the q blocks can hold this step (cache's q_rows; at q).
+  void collect_q_rows(const StepContext& ctx, TermCache& cache, const Configuration& q) const;
   /// Fills the cache's patch nodes around the seed vertices (φ of each seed; contact_patch.cpp).
   void select_patch_nodes(TermCache& cache, const std::vector<int>& seeds, const std::vector<double>& seed_phi) const;
   /// The dynamic object's 6 DoFs in the term's local system, or −1.
