@@ -22,6 +22,7 @@
 #include "sflsh/sim/posed_points.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
+#include "sim/energies/contact_patch_cache.hpp"
 #include "synthetic_avatar.hpp"
 #include "test_support.hpp"
 
@@ -812,6 +813,22 @@ TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFinit
   term.evaluate(ctx, q, &g_with_hessian, &H);
   EXPECT_LT((g_with_hessian - g_alone).norm(), 1e-8 * g_alone.norm());
   EXPECT_GT(H.norm(), 0);
+  {
+    // The q blocks hold nonzeros only in the rows begin_step collected: an
+    // evaluation zeroes, and the condensation reads, only those (a row it
+    // missed would keep old values and be left out of the step).
+    const contact_patch_detail::PatchCache& c = contact_patch_detail::patch_cache(ctx, term.name());
+    const int z0 = ctx.layout.z_offset();
+    std::vector<char> collected(size_t(n), 0);
+    for (int r : c.q_rows) collected[size_t(r)] = 1;
+    EXPECT_TRUE(collected[size_t(ctx.layout.size())]) << "the ball's rows";
+    for (int r = 0; r < n; ++r) {
+      if (collected[size_t(r)]) continue;
+      EXPECT_EQ(c.start.Hqq.row(r).cwiseAbs().maxCoeff() + c.start.Hqq.col(r).cwiseAbs().maxCoeff(), 0) << r;
+      EXPECT_EQ(c.Hqp.row(r).cwiseAbs().maxCoeff(), 0) << r;
+      if (r >= z0 && r < z0 + c.Hzp_stiffening.rows()) EXPECT_EQ(c.Hzp_stiffening.row(r - z0).cwiseAbs().maxCoeff(), 0) << r;
+    }
+  }
   // The ball's generalized force is the reaction of the contact force on the body: −f along v.
   const auto r = term.report(ctx, q);
   const Vec3 f(quantity(r, "force", 0), quantity(r, "force", 1), quantity(r, "force", 2));
