@@ -76,6 +76,12 @@ void run_scene_file(const SimulateArgs& a, bool out_given) {
   if (!out.render.empty()) io::check_output_file(out.render, a.render.empty() ? "output.render" : "--render");
   if (!out.export_path.empty()) io::check_output_file(out.export_path, a.exp.empty() ? "output.export" : "--export");
   SceneRunOptions o;
+  o.checkpoint = a.checkpoint;
+  o.resume = a.resume;
+  if (!a.resume.empty()) io::require_input_file(a.resume, "--resume");
+  if (!a.checkpoint.empty()) io::check_output_file(a.checkpoint, "--checkpoint");
+  require(a.solver == "reduced" || (a.checkpoint.empty() && a.resume.empty()),
+          "simulate: --checkpoint and --resume run with the reduced solver (the full-FEM reference keeps no checkpoint)");
   prepare_scene_assets(scene, a.cache_dir.empty() ? default_cache_dir() : a.cache_dir);
   SceneContactStats stats;
   SimulationResult r;
@@ -287,9 +293,11 @@ const CommandRegistrar reg(40, [](CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--strict", a->strict, "Exit non-zero (after writing the result) when the tracking tolerance is exceeded");
-  cmd->add_option("--checkpoint", a->checkpoint, "Also save the final state (HDF5) to continue from with --resume");
+  cmd->add_option("--checkpoint", a->checkpoint,
+                  "Also save the final state (HDF5; a scene's tools' grasps with it) to continue from with --resume");
   cmd->add_option("--resume", a->resume,
-                  "Continue from a --checkpoint file: same avatar, motion and options; --seconds is the end time");
+                  "Continue from a --checkpoint file: same avatar, motion and options (--seconds is the end time), "
+                  "or the same scene file (its end is the scene's)");
   cmd->add_option("--export", a->exp, "Also write result.pc2 (+ rest mesh), an animated result.glb, or frames_%04d.obj/.ply/.glb");
   cmd->add_option("--render", a->render, "Also write a PNG strip of frames coloured by soft displacement");
   cmd->add_option("--render-frames", a->render_frames, "Frames in the --render strip")->capture_default_str();

@@ -17,6 +17,7 @@
 #include "sflsh/core/interrupt.hpp"
 #include "sflsh/core/progress.hpp"
 #include "sflsh/io/atomic_output.hpp"
+#include "sflsh/scene/scene_checkpoint.hpp"
 #include "sflsh/scene/scene_session.hpp"
 #include "sflsh/sim/finite_guard.hpp"
 #include "sflsh/sim/momentum.hpp"
@@ -125,7 +126,32 @@ void SceneSession::set_stiffness_scale(double scale, int body) {
 
 void SceneSession::resume(const State& state, const std::string& where) {
   Impl& m = *impl_;
-  require(m.tools.empty(), where, ": a checkpoint holds no tool (grasps, devices); the scene has ", m.tools.size());
+  require(m.tools.empty(), where, ": a State holds no tool's grasp; the scene has ", m.tools.size(),
+          " tool(s): resume from the checkpoint file (SceneSession::resume(path))");
+  resume_at(state, where);
+}
+
+void SceneSession::resume(const std::string& path) {
+  Impl& m = *impl_;
+  std::vector<ToolCheckpoint> tools;
+  for (const ToolDriver& t : m.tools) tools.push_back({t.name(), t.grasped()});
+  std::vector<int> skin;
+  for (const CompiledBody& b : m.compiled.bodies) skin.push_back(int(b.avatar->surface_rest.rows()));
+  const State state = read_scene_checkpoint(path, m.sim->model(), tools, skin);
+  for (ToolDriver& t : m.tools) t.reset();
+  resume_at(state, path);
+  for (size_t i = 0; i < m.tools.size(); ++i) m.tools[i].resume(*m.sim, state.time, std::move(tools[i].grasps));
+}
+
+void SceneSession::write_checkpoint(const std::string& path) const {
+  const Impl& m = *impl_;
+  std::vector<ToolCheckpoint> tools;
+  for (const ToolDriver& t : m.tools) tools.push_back({t.name(), t.grasped()});
+  write_scene_checkpoint(path, m.sim->model(), m.sim->scene_state(), tools);
+}
+
+void SceneSession::resume_at(const State& state, const std::string& where) {
+  Impl& m = *impl_;
   m.sim->set_state(state);
   const double h = m.compiled.h, time = m.sim->time();
   const long k = std::lround(time / h);
@@ -327,7 +353,7 @@ class FrameRecorder {
 }  // namespace
 
 SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& opt, SceneContactStats* stats) {
-  if (!opt.resume.empty()) scene.resume(read_state(opt.resume, scene.simulator().model()), opt.resume);
+  if (!opt.resume.empty()) scene.resume(opt.resume);
   const long steps = scene.total_steps();
   SimulationResult r = scene.result_header();
   FrameRecorder frames(scene, opt, r);
@@ -371,7 +397,7 @@ SimulationResult run_scene(SceneSession& scene, const SceneRunOptions& opt, Scen
   r.tool_events = scene.tool_events();  // also those after the last frame
   if (stats) *stats = contact.finish();
   if (!opt.checkpoint.empty())
-    write_state(opt.checkpoint, scene.simulator().model(), scene.simulator().scene_state());
+    scene.write_checkpoint(opt.checkpoint);
   return r;
 }
 

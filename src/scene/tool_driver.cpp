@@ -109,6 +109,27 @@ void ToolDriver::reset() {
   recorder_.reset();  // drops the rows so far (before start() opens the file again)
 }
 
+void ToolDriver::resume(const Simulator& sim, double t, std::vector<std::vector<Anchor>> grasps) {
+  require(grasps.size() == grasps_.size(), "tool '", name(), "': ", grasps.size(), " bodies' grasps to resume, the tool has ",
+          grasps_.size());
+  for (size_t b = 0; b < grasps.size(); ++b) grasps_[b].restore(std::move(grasps[b]));
+  device_now_ = track_->at(t, hold_ ? PoseInterpolation::kHold : PoseInterpolation::kLinear);
+  state_.device = device_now_;
+  state_.pose = pose(sim);
+  if (!options_.record_dir.empty()) {
+    recorder_ = std::make_unique<teleop::PoseRecorder>(
+        (std::filesystem::path(options_.record_dir) / (name() + ".csv")).string());
+    recorder_->record({0, device_now_, t});
+    recorded_ = device_now_;
+  }
+}
+
+std::vector<std::vector<Anchor>> ToolDriver::grasped() const {
+  std::vector<std::vector<Anchor>> out;
+  for (const GraspController& g : grasps_) out.push_back(g.anchors());
+  return out;
+}
+
 void ToolDriver::push(const PoseSample& sample) {
   require(sample.position.allFinite() && sample.orientation.coeffs().allFinite() && std::isfinite(sample.closure),
           "tool '", name(), "': device pose is not finite");

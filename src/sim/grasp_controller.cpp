@@ -15,6 +15,13 @@ GraspController::GraspController(GraspOptions options) : options_(std::move(opti
             "grasp: a proximity sensor needs a finite origin, a non-zero direction and a range >= 0 m");
 }
 
+void GraspController::restore(std::vector<Anchor> anchors) {
+  for (const Anchor& a : anchors)
+    require(a.point >= 0 && a.offset.allFinite(), "grasp: restored anchor of point ", a.point,
+            " needs a point >= 0 and a finite offset");
+  anchors_ = std::move(anchors);
+}
+
 bool GraspController::update(double time, const Isometry& jaw_pose, double closure, const Points& skin,
                              const Triangles& faces) {
   require(std::isfinite(closure), "grasp: closure is not finite at t = ", time, " s");

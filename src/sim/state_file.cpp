@@ -34,7 +34,8 @@ std::vector<Isometry> unpack_bones(const MatXr& m) {
 
 }  // namespace
 
-void write_state(const std::string& path, const Model& model, const State& state) {
+void write_state(const std::string& path, const Model& model, const State& state,
+                 const std::function<void(io::Hdf5File&)>& more) {
   validate_state(model, state);
   io::Hdf5File f(path, io::Hdf5File::Mode::Write);
   f.write_scalar("/meta/format_version", std::int64_t(kStateFormatVersion));
@@ -64,10 +65,12 @@ void write_state(const std::string& path, const Model& model, const State& state
     saved.push_back(int(j));
   }
   if (!saved.empty()) f.write_nd("/state/caches/terms", saved.data(), {std::int64_t(saved.size())});
+  if (more) more(f);
   f.commit();
 }
 
-static State read_state_in_this_process(const std::string& path, const Model& model) {
+static State read_state_in_this_process(const std::string& path, const Model& model,
+                                        const std::function<void(const io::Hdf5File&)>& more) {
   io::Hdf5File f(path, io::Hdf5File::Mode::Read);
   require(f.has("/meta/kind") && f.read_string("/meta/kind") == "sflsh state", path,
           ": not an sflsh state file (/meta/kind is missing or not \"sflsh state\")");
@@ -99,6 +102,7 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
   } catch (const Error& e) {
     fail(path, ": ", e.what());
   }
+  if (more) more(f);
   if (!f.has("/state/caches/terms")) return s;
   require(version == kStateFormatVersion, path, ": /meta/format_version is ", version,
           ": its term caches (the contact patch's history) are in an older layout; write the checkpoint again "
@@ -120,9 +124,9 @@ static State read_state_in_this_process(const std::string& path, const Model& mo
   return s;
 }
 
-State read_state(const std::string& path, const Model& model) {
+State read_state(const std::string& path, const Model& model, const std::function<void(const io::Hdf5File&)>& more) {
   // A file on which libhdf5 itself crashes is refused, not read (io/crash_isolation.hpp).
-  return io::read_in_child_first(path, [&] { return read_state_in_this_process(path, model); });
+  return io::read_in_child_first(path, [&] { return read_state_in_this_process(path, model, more); });
 }
 
 }  // namespace sflsh

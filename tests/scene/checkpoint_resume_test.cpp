@@ -5,6 +5,8 @@
 // dataset.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -165,4 +167,135 @@ TEST_F(CheckpointResume, BadCachesAreRefusedNamingTheFileAndTheDataset) {
   test::expect_error([&] { read_state(beyond, model); }, {beyond, "/state/caches/terms[0] is 99"});
   const std::string keeps_none = crafted("elastic.h5", "elastic", one_node, elastic_term);
   test::expect_error([&] { read_state(keeps_none, model); }, {keeps_none, "/state/caches/" + std::to_string(elastic_term) + "/values", "carries no state"});
+}
+
+namespace {
+
+/// The box pinch (box_avatar_fixture.hpp) as written, and with the gripper
+/// coupled (a dynamic tool body, in the State) pulling through a contact patch.
+std::string pinch_scene(bool coupled) {
+  std::string text = test::kBoxPinchScene;
+  if (!coupled) return text;
+  text = "contact: {patch: true, friction: 0}\n" + text;
+  const std::string grasp = "    grasp:\n";
+  text.insert(text.find(grasp), "    coupling: {stiffness: 2000, mass: 0.05, max_force: 100}\n");
+  return text;
+}
+
+std::vector<std::vector<int>> held_points(const SceneSession& s) {
+  std::vector<std::vector<int>> out;
+  for (int t = 0; t < s.num_tools(); ++t) out.push_back({s.tool_state(t).anchors});
+  return out;
+}
+
+}  // namespace
+
+/// A checkpoint taken while the gripper holds the skin (after its grasp, in
+/// the lift) resumes with the grasp: the run goes on, releases at 0.25 s and
+/// ends as the uninterrupted one, bit for bit. Resumed without the grasp,
+/// the skin drops back and the runs part.
+TEST_F(CheckpointResume, AToolsGraspResumesBitForBit) {
+  for (bool coupled : {false, true}) {
+    SCOPED_TRACE(coupled ? "coupled gripper through a patch" : "kinematic gripper");
+    const SceneDescription sc = read_scene_description(write_scene(pinch_scene(coupled)));
+    SceneSession whole(sc, quiet());
+    for (int i = 0; i < 12; ++i) whole.advance();
+    ASSERT_GT(whole.tool_state(0).anchors, 0) << "the gripper should hold the skin by 0.12 s";
+    const std::string path = (dir_ / "holding.h5").string();
+    whole.write_checkpoint(path);
+
+    SceneSession resumed(sc, quiet());
+    resumed.resume(path);
+    EXPECT_EQ(resumed.steps_done(), 12);
+    for (int i = 0; i < 6; ++i) whole.advance(), resumed.advance();
+    EXPECT_EQ(held_points(resumed), held_points(whole)) << "still holding after the resume";
+    const auto lifted = whole.body_surface(0);  // at 0.18 s
+    while (whole.steps_done() < whole.total_steps()) whole.advance(), resumed.advance();
+    EXPECT_EQ(resumed.time(), whole.time());
+    EXPECT_EQ(resumed.simulator().scene_state().bodies[0].q.z, whole.simulator().scene_state().bodies[0].q.z);
+    EXPECT_EQ(resumed.body_surface(0), whole.body_surface(0));
+    EXPECT_EQ(resumed.tool_state(0).pose.matrix(), whole.tool_state(0).pose.matrix());
+    // The resumed run's events: the release alone (the grasp was before it).
+    ASSERT_EQ(resumed.tool_events().size(), 1u);
+    EXPECT_EQ(resumed.tool_events()[0].kind, "release");
+    EXPECT_EQ(resumed.tool_events()[0].time, whole.tool_events().back().time);
+
+    // The same file without the grasp: the skin is let go at the resume.
+    const std::string let_go = (dir_ / "let_go.h5").string();
+    {
+      const io::Hdf5File in(path, io::Hdf5File::Mode::Read);
+      io::Hdf5File f(let_go, io::Hdf5File::Mode::Write);
+      f.write_scalar("/meta/format_version", std::int64_t(kStateFormatVersion));
+      f.write_string("/meta/kind", "sflsh state");
+      f.write_scalar("/state/time", in.read_scalar("/state/time"));
+      f.write_strings("/state/bodies", in.read_strings("/state/bodies"));
+      for (int b = 0; b < int(in.read_strings("/state/bodies").size()); ++b) {
+        const std::string g = "/state/" + std::to_string(b) + "/";
+        for (const char* d : {"bones", "bones_prev"}) f.write_matrix(g + d, in.read_matrix(g + d));
+        for (const char* d : {"z", "z_prev"}) {
+          const std::vector<double> v = in.read_nd(g + d, {-1});
+          f.write_nd(g + d, v.data(), {std::int64_t(v.size())});
+        }
+      }
+      f.write_strings("/tools/names", {"gripper"});
+      f.write_scalar("/tools/0/bodies", std::int64_t(1));
+      f.commit();
+    }
+    SceneSession dropped(sc, quiet());
+    dropped.resume(let_go);
+    EXPECT_EQ(dropped.tool_state(0).anchors, 0);
+    for (int i = 0; i < 6; ++i) dropped.advance();
+    EXPECT_GT((dropped.body_surface(0) - lifted).cwiseAbs().maxCoeff(), 1e-4) << "the skin should drop back";
+  }
+}
+
+TEST_F(CheckpointResume, AToolScenesCheckpointIsCheckedAgainstTheScene) {
+  const SceneDescription sc = read_scene_description(write_scene(pinch_scene(false)));
+  SceneSession s(sc, quiet());
+  for (int i = 0; i < 12; ++i) s.advance();
+  const std::string good = (dir_ / "good.h5").string();
+  s.write_checkpoint(good);
+  // A State alone holds no grasp.
+  const State state = read_state(good, s.simulator().model());
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(state, good); },
+                     {good, "holds no tool's grasp", "resume from the checkpoint file"});
+  // A copy of the file with its tools' part rewritten.
+  auto crafted = [&](const std::string& name, const std::function<void(io::Hdf5File&)>& tools) {
+    const std::string path = (dir_ / name).string();
+    write_state(path, s.simulator().model(), s.simulator().scene_state(), tools);
+    return path;
+  };
+  const std::string none = crafted("none.h5", nullptr);
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(none); }, {none, "holds no tools' state", "1 tool(s)"});
+  const std::string renamed = crafted("renamed.h5", [](io::Hdf5File& f) {
+    f.write_strings("/tools/names", {"pliers"});
+    f.write_scalar("/tools/0/bodies", std::int64_t(1));
+  });
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(renamed); },
+                     {renamed, "/tools/names[0] is 'pliers'", "'gripper'"});
+  const std::string two_bodies = crafted("bodies.h5", [](io::Hdf5File& f) {
+    f.write_strings("/tools/names", {"gripper"});
+    f.write_scalar("/tools/0/bodies", std::int64_t(2));
+  });
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(two_bodies); }, {two_bodies, "/tools/0/bodies is 2"});
+  auto holding = [&](const std::string& name, int point, double offset) {
+    return crafted(name, [=](io::Hdf5File& f) {
+      f.write_strings("/tools/names", {"gripper"});
+      f.write_scalar("/tools/0/bodies", std::int64_t(1));
+      f.write_nd("/tools/0/0/points", &point, {1});
+      MatXr o(1, 3);
+      o << 0.001, offset, 0.0;
+      f.write_matrix("/tools/0/0/offsets", o);
+    });
+  };
+  const std::string far = holding("far.h5", 100000, 0.0);
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(far); }, {far, "/tools/0/0/points[0] is 100000", "skin vertices"});
+  const std::string nan = holding("nan.h5", 3, std::nan(""));
+  test::expect_error([&] { SceneSession(sc, quiet()).resume(nan); }, {nan, "/tools/0/0/offsets"});
+  // The helper is sound: one anchor held on a skin vertex resumes.
+  SceneSession one(sc, quiet());
+  one.resume(holding("one.h5", 3, -0.002));
+  EXPECT_EQ(one.steps_done(), 12);
+  one.advance();
+  EXPECT_EQ(one.tool_state(0).anchors, 1);
 }

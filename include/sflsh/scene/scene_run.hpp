@@ -30,7 +30,8 @@ struct SceneRunOptions {
   std::function<void(const Simulator&, const StepReport&)> on_step;
   /// Continue from this checkpoint (sim/state_file.hpp) instead of the
   /// scene's start: the run goes from the checkpoint's time to the scene's
-  /// end, its frames start at the checkpoint's time. Not with tools.
+  /// end, its frames start at the checkpoint's time; tools resume with what
+  /// they hold (scene/scene_checkpoint.hpp).
   std::string resume;
   /// Save the final state here (a checkpoint to resume from).
   std::string checkpoint;

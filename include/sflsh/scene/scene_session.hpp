@@ -105,8 +105,13 @@ class SceneSession {
   /// Continues from `state` (a checkpoint of this scene's model, sim/state_file.hpp):
   /// steps_done() becomes its time in steps. Throws naming `where` when its
   /// time is not a whole number of steps or past the scene's end, or when the
-  /// scene has tools (their grasps and devices are not in a checkpoint).
+  /// scene has tools (a State holds no grasp: resume from a file instead).
   void resume(const State& state, const std::string& where);
+  /// Continues from the checkpoint file `path` (scene/scene_checkpoint.hpp):
+  /// the state and what the tools hold; as resume(state) otherwise.
+  void resume(const std::string& path);
+  /// Writes the current state and the tools' grasps to `path` (atomically).
+  void write_checkpoint(const std::string& path) const;
   const StepReport& last_report() const;
 
   /// Back to the scene's start (time 0, steps_done() 0): every body, dynamic
@@ -199,6 +204,8 @@ class SceneSession {
   const Simulator& simulator() const;
 
  private:
+  /// resume(state)'s part without the tools.
+  void resume_at(const State& state, const std::string& where);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -84,6 +84,14 @@ class ToolDriver {
   /// Back to before start(): pushed and streamed poses dropped, grasps
   /// released, state cleared, the recording's rows so far dropped.
   void reset();
+  /// Continues at time t (after reset()) from a checkpoint: the simulator
+  /// holds its state (a coupled tool's body in it), `grasps` what the tool
+  /// held per body. The pose source is read from t on (a live stream takes
+  /// over again, ramped, as at the start); a recording starts at t.
+  void resume(const Simulator& sim, double t, std::vector<std::vector<Anchor>> grasps);
+  /// The anchors held per body now (empty per body without a grasp; none
+  /// for a tool without sensors).
+  std::vector<std::vector<Anchor>> grasped() const;
   /// The device pose of the next steps (world, closure rad; normalized): the
   /// tool follows pushed poses from now on. Throws on a non-finite pose or a
   /// zero quaternion.

@@ -44,6 +44,9 @@ class GraspController {
   bool update(double time, const Isometry& jaw_pose, double closure, const Points& skin, const Triangles& faces);
   /// The current anchors: skin vertex and offset in the jaw frame (m).
   const std::vector<Anchor>& anchors() const { return anchors_; }
+  /// Holds `anchors` as if grasped before (a resumed checkpoint); the log is
+  /// unchanged. Throws on a non-finite offset or a negative point.
+  void restore(std::vector<Anchor> anchors);
   bool grasping() const { return !anchors_.empty(); }
   /// Whether update() at this closure would cast the sensors (closed, nothing
   /// held yet): only then does it read the skin (callers may pass an empty one otherwise).

@@ -18,8 +18,13 @@
 //   /state/caches/<j>/name          term j's name (checked against the scene)
 //   /state/caches/<j>/values (N,)   its saved state
 // Doubles are stored exactly (no float32), so a restored state equals the saved one.
+// A caller may add groups of its own outside /meta and /state (a scene's
+// tools: scene/scene_checkpoint.hpp), written into the same file before it
+// is renamed into place and read in the same pass.
+#include <functional>
 #include <string>
 
+#include "sflsh/io/hdf5_file.hpp"
 #include "sflsh/sim/model.hpp"
 #include "sflsh/sim/state.hpp"
 
@@ -27,12 +32,17 @@ namespace sflsh {
 
 inline constexpr int kStateFormatVersion = 3;
 
-/// Writes `state` of `model` to `path` (atomically: NAME.partial, then renamed).
-void write_state(const std::string& path, const Model& model, const State& state);
+/// Writes `state` of `model` to `path` (atomically: NAME.partial, then
+/// renamed); `more`, when given, writes the caller's groups into the file.
+void write_state(const std::string& path, const Model& model, const State& state,
+                 const std::function<void(io::Hdf5File&)>& more = nullptr);
 
 /// Reads a state saved for a model like `model`: the body names, their count
 /// and each body's K must match, and each saved cache's term its name (else
-/// one error naming the file and field).
-State read_state(const std::string& path, const Model& model);
+/// one error naming the file and field). `more`, when given, reads the
+/// caller's groups from the file (it may run twice: a first pass in a child
+/// process guards against files on which libhdf5 crashes).
+State read_state(const std::string& path, const Model& model,
+                 const std::function<void(const io::Hdf5File&)>& more = nullptr);
 
 }  // namespace sflsh
