@@ -131,10 +131,18 @@ void SceneSession::resume(const State& state, const std::string& where) {
   resume_at(state, where);
 }
 
+namespace {
+/// What each tool holds now, for a checkpoint (scene_checkpoint.hpp).
+std::vector<ToolCheckpoint> tool_checkpoints(const std::vector<ToolDriver>& tools) {
+  std::vector<ToolCheckpoint> out;
+  for (const ToolDriver& t : tools) out.push_back({t.name(), t.grasped()});
+  return out;
+}
+}  // namespace
+
 void SceneSession::resume(const std::string& path) {
   Impl& m = *impl_;
-  std::vector<ToolCheckpoint> tools;
-  for (const ToolDriver& t : m.tools) tools.push_back({t.name(), t.grasped()});
+  std::vector<ToolCheckpoint> tools = tool_checkpoints(m.tools);
   std::vector<int> skin;
   for (const CompiledBody& b : m.compiled.bodies) skin.push_back(int(b.avatar->surface_rest.rows()));
   const State state = read_scene_checkpoint(path, m.sim->model(), tools, skin);
@@ -145,9 +153,7 @@ void SceneSession::resume(const std::string& path) {
 
 void SceneSession::write_checkpoint(const std::string& path) const {
   const Impl& m = *impl_;
-  std::vector<ToolCheckpoint> tools;
-  for (const ToolDriver& t : m.tools) tools.push_back({t.name(), t.grasped()});
-  write_scene_checkpoint(path, m.sim->model(), m.sim->scene_state(), tools);
+  write_scene_checkpoint(path, m.sim->model(), m.sim->scene_state(), tool_checkpoints(m.tools));
 }
 
 void SceneSession::resume_at(const State& state, const std::string& where) {

@@ -422,24 +422,18 @@ void ContactPatchTerm::collect_q_rows(const StepContext& ctx, TermCache& cache, 
     for (int k = 0; k < 6; ++k) mark[size_t(ob + k)] = 1;
   // A system of another size: every row may hold an old value (the blocks are
   // zeroed whole when they are resized, but one of this size may be kept).
-  if (c.q_row_written.size() != size_t(nq)) {
-    c.q_row_written.assign(size_t(nq), c.q_row_written.empty() ? 0 : 1);
-    c.q_rows_written.clear();
-    for (int r = 0; r < nq; ++r)
-      if (c.q_row_written[size_t(r)]) c.q_rows_written.push_back(r);
-  }
+  bool changed = c.q_row_written.size() != size_t(nq);
+  if (changed) c.q_row_written.assign(size_t(nq), c.q_row_written.empty() ? 0 : 1);
   c.q_rows.clear();
-  bool grew = false;
   for (int r = 0; r < nq; ++r) {
     if (!mark[size_t(r)]) continue;
     c.q_rows.push_back(r);
-    if (!c.q_row_written[size_t(r)]) c.q_row_written[size_t(r)] = 1, grew = true;
+    if (!c.q_row_written[size_t(r)]) c.q_row_written[size_t(r)] = 1, changed = true;
   }
-  if (grew) {
-    c.q_rows_written.clear();
-    for (int r = 0; r < nq; ++r)
-      if (c.q_row_written[size_t(r)]) c.q_rows_written.push_back(r);
-  }
+  if (!changed) return;
+  c.q_rows_written.clear();
+  for (int r = 0; r < nq; ++r)
+    if (c.q_row_written[size_t(r)]) c.q_rows_written.push_back(r);
 }
 
 bool ContactPatchTerm::active(const StepContext& ctx) const {
