@@ -23,7 +23,6 @@ struct ContactPatchTerm::Evaluation {
   MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
   MatX Hqp;  // cross block (layout rows by patch DoFs)
   MatX Hzp_stiffening;  // what the dented tets' stiffness adds to Hqp's z rows: Wᵀ (K1 − K0), by patch DoFs
-  MatX K0pp; // the subspace state's element stiffness over the patch DoFs (with the q Hessian)
   Vec3 force = Vec3::Zero();
   Vec3 point_sum = Vec3::Zero();  // Σ |f_s| x_s over the touching samples (world, m·N)
   double point_weight = 0;        // Σ |f_s|
@@ -87,6 +86,14 @@ struct PatchCache : TermCache {
   // and per patch tet the pair of each of its (k, l) node pairs (−1: l not a patch node).
   std::vector<int> cross_first, cross_slot;
   std::vector<std::array<int, 16>> tet_cross;
+  // Per (tet node, patch slot) pair: Σ over the patch tets of the subspace
+  // share's stiffness block K0 (constant for a set of tets).
+  std::vector<Mat3> node_cross;
+  // K0_pp: the subspace share's stiffness over the patch DoFs (the guard's, compute).
+  MatX K0pp;
+  // add_patch_elasticity's accumulators, kept for their storage.
+  std::vector<Vec3> scratch_node_grad;
+  std::vector<Mat3> scratch_node_stiffening;
   std::vector<Mat9> tet_H2;
   // Per patch tet, the subspace's quadratic share (constant): its Hessian per
   // unit volume and its stiffness blocks over the tet's node pairs.

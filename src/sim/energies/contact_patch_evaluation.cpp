@@ -78,7 +78,7 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   // more than zeroing them).
   VecX gp = std::move(out.gp), gq = std::move(out.gq);
   MatX Hpp = std::move(out.Hpp), Hqq = std::move(out.Hqq), Hqp = std::move(out.Hqp);
-  MatX Hzp = std::move(out.Hzp_stiffening), K0pp = std::move(out.K0pp);
+  MatX Hzp = std::move(out.Hzp_stiffening);
   out = Evaluation();
   out.gp = std::move(gp);
   out.gp.setZero(np);
@@ -88,7 +88,6 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   out.Hqq = std::move(Hqq);
   out.Hqp = std::move(Hqp);
   out.Hzp_stiffening = std::move(Hzp);
-  out.K0pp = std::move(K0pp);
   if (q_hessian) {
     // The q blocks are zero outside the rows any evaluation has written (PatchCache::q_rows_written).
     const PatchCache& c = patch_cache(ctx, name());
@@ -113,7 +112,6 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
       for (int r : rows)
         if (r >= z0 && r < z0 + L.num_reduced) out.Hzp_stiffening.row(r - z0).setZero();
     }
-    out.K0pp.setZero(np, np);
   }
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
   const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);
@@ -210,17 +208,21 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
   const bool q_hessian = q_derivatives && mode.q_hessian;
   const bool hessian = mode.p_derivatives || q_hessian;  // a gradient alone (a trial's) needs no element Hessian
   const bool subspace = mode.subspace_energy || q_derivatives;
-  const PatchCache& c = patch_cache(ctx, name());
+  PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
   const int z0 = local_layout(ctx).z_offset();
   auto simulated = [&](int n) { return a.node_role.size() == 0 || a.node_role[n] == int(NodeRole::Simulated); };
   const size_t nt = c.tet_nodes.size();
   const std::vector<Vec3> us = tet_node_subspace_displacements(a, c, q.z);
-  // Per tet node: ∂Φ/∂u_n and the cross blocks K0 against the patch slots,
-  // taken through W once per node after the loop.
-  std::vector<Vec3> node_grad(q_derivatives ? nt : 0, Vec3::Zero());
-  std::vector<Mat3> node_cross(q_hessian ? c.cross_slot.size() : 0, Mat3::Zero());  // per (node, slot) pair
-  std::vector<Mat3> node_stiffening(node_cross.size(), Mat3::Zero());                  // K1 − K0, the same pairs
+  // Per tet node: ∂Φ/∂u_n, and per (node, patch slot) pair the dented tets'
+  // K1 − K0 (the subspace's own K0 per pair is constant: c.node_cross),
+  // taken through W once per node after the loop. The cache's scratch keeps
+  // their storage (fresh pages cost more than the sums).
+  std::vector<Vec3>& node_grad = c.scratch_node_grad;
+  std::vector<Mat3>& node_stiffening = c.scratch_node_stiffening;
+  node_grad.assign(q_derivatives ? nt : 0, Vec3::Zero());
+  node_stiffening.assign(q_hessian ? c.cross_slot.size() : 0, Mat3::Zero());
+  const std::vector<Mat3>& node_cross = c.node_cross;
   double E = 0;
   for (size_t ti = 0; ti < c.tets.size(); ++ti) {
     const int t = c.tets[ti];
@@ -264,19 +266,14 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
         out.gp.segment<3>(3 * slot[k]) += V * (P1 * gk);
         if (hessian)
           for (int l = 0; l < 4; ++l)
-            if (slot[l] >= 0) {
-              out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
-              if (q_hessian) out.K0pp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K0[k][l];
-            }
+            if (slot[l] >= 0) out.Hpp.block<3, 3>(3 * slot[k], 3 * slot[l]) += K[k][l];
       }
       if (!q_derivatives) continue;
       node_grad[size_t(local[k])] += V * ((P1 - P0) * gk);
       if (!q_hessian) continue;
       for (int l = 0; l < 4; ++l)
         if (slot[l] >= 0) {
-          const size_t e = size_t(c.tet_cross[ti][size_t(4 * k + l)]);
-          node_cross[e] += K0[k][l];
-          node_stiffening[e] += K[k][l] - K0[k][l];
+          node_stiffening[size_t(c.tet_cross[ti][size_t(4 * k + l)])] += K[k][l] - K0[k][l];
         }
     }
   }
