@@ -50,10 +50,11 @@
 //
 // Condensation (Teng et al. 2015, "Subspace condensation"): the term's energy
 // is E(q) = min_δu Φ(q, δu), the patch minimized out at every evaluation
-// (Newton on δu with q fixed: a small dense system, a few iterations). Then
-// ∂E/∂q = ∂Φ/∂q at the minimizer (envelope theorem) and the Hessian is the
-// Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq, so the global step stays one
-// Newton step over bones and handles. Approximations, all in the Hessian
+// (Newton on δu with q fixed: a small sparse system, factored by a sparse
+// Cholesky whose analysis is kept while its pattern holds; a few iterations).
+// Then ∂E/∂q = ∂Φ/∂q at the minimizer (envelope theorem) and the Hessian is
+// the Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq over the rows the patch
+// touches, so the global step stays one Newton step over bones and handles. Approximations, all in the Hessian
 // only: Gauss–Newton for the contact, the element Hessians PSD-projected, the
 // change of the elastic Hessian in the patch (K(Wz + δu) − K^sub(Wz)) reduced
 // to its small-strain part (the bulk share mean dilatation leaves out, rank
