@@ -14,6 +14,7 @@
 #include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
+#include "finite_difference.hpp"
 #include "synthetic_avatar.hpp"
 #include "test_support.hpp"
 
@@ -203,16 +204,7 @@ TEST(PatchAnchors, CondensedEnergyGradientMatchesFiniteDifferences) {
     VecX g = VecX::Zero(n);
     const double E = term.evaluate(ctx, q, &g, nullptr);
     ASSERT_GT(E, 0);
-    VecX fd(n);
-    const double eps = 1e-7;
-    for (int i = 0; i < n; ++i) {
-      VecX d = VecX::Zero(n);
-      d[i] = eps;
-      const double Ep = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-      d[i] = -eps;
-      const double Em = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-      fd[i] = (Ep - Em) / (2 * eps);
-    }
+    const VecX fd = test::fd_gradient(term, ctx, q, 1e-7);
     EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "|g| " << g.norm() << ", |fd| " << fd.norm();
     // The report: one force per anchor, summing to "force", the tool's pull up.
     const std::vector<TermQuantity> r = term.report(ctx, q);

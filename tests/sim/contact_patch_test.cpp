@@ -23,6 +23,7 @@
 #include "sflsh/sim/simulator.hpp"
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sim/energies/contact_patch_cache.hpp"
+#include "finite_difference.hpp"
 #include "synthetic_avatar.hpp"
 #include "test_support.hpp"
 
@@ -62,22 +63,6 @@ double quantity(const std::vector<TermQuantity>& r, const std::string& name, int
     if (q.name == name) return q.value[i];
   ADD_FAILURE() << "no quantity " << name;
   return NAN;
-}
-
-/// Central differences (step 1e-7) of the term's energy at q over the body's layout.
-VecX energy_gradient_fd(const ContactPatchTerm& term, const StepContext& ctx, const Configuration& q) {
-  const int n = ctx.layout.size();
-  VecX fd(n);
-  const double eps = 1e-7;
-  for (int i = 0; i < n; ++i) {
-    VecX d = VecX::Zero(n);
-    d[i] = eps;
-    const double Ep = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-    d[i] = -eps;
-    const double Em = term.evaluate(ctx, retract(q, d, ctx.layout), nullptr, nullptr);
-    fd[i] = (Ep - Em) / (2 * eps);
-  }
-  return fd;
 }
 
 TEST(ContactPatch, UniformPenetrationGivesPressureStiffnessTimesDepthTimesArea) {
@@ -152,7 +137,7 @@ TEST(ContactPatch, CondensedEnergyGradientMatchesFiniteDifferences) {
     VecX g = VecX::Zero(n);
     const double E = term.evaluate(ctx, q, &g, nullptr);
     ASSERT_GT(E, 0);
-    const VecX fd = energy_gradient_fd(term, ctx, q);
+    const VecX fd = test::fd_gradient(term, ctx, q, 1e-7);
     EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "bones dynamic " << dynamic << ", " << press << " m: |g| " << g.norm()
                                                   << ", |fd| " << fd.norm();
     // The gradient asked with the Hessian (the Newton iteration) is the one
@@ -290,7 +275,7 @@ TEST(ContactPatch, AnUnconvergedPatchEntersTheStepThroughTheBorderedRightHandSid
   MatX H = MatX::Zero(n, n);
   term.evaluate(ctx, q0, &g, &H);
   term.evaluate(ctx, q0, &g_at_start, nullptr);  // Φ_q at (q0, δu0)
-  const VecX fd = energy_gradient_fd(term, ctx, q0);
+  const VecX fd = test::fd_gradient(term, ctx, q0, 1e-7);
   const double error = (g - fd).norm(), without = (g_at_start - fd).norm();
   EXPECT_GT(without, 1e-3 * fd.norm()) << "the inner minimization should stop short here";
   EXPECT_LT(error, 0.05 * without) << "|g − ∇f| " << error << ", without the Φ_p term " << without << ", |∇f| " << fd.norm();

@@ -13,14 +13,17 @@ inline double energy_at(const EnergyTerm& term, const StepContext& ctx, const Co
   return term.evaluate(ctx, retract(q, delta, ctx.layout), nullptr, nullptr);
 }
 
-/// Central-difference gradient (layout.size()).
+/// Central-difference gradient (layout.size()). The + side is evaluated
+/// first (a term with a warm-started inner minimization, as the contact
+/// patch, sees the same sequence of evaluations every run).
 inline VecX fd_gradient(const EnergyTerm& term, const StepContext& ctx, const Configuration& q, double eps) {
   const int n = ctx.layout.size();
   VecX g(n);
   for (int i = 0; i < n; ++i) {
     VecX d = VecX::Zero(n);
     d[i] = eps;
-    g[i] = (energy_at(term, ctx, q, d) - energy_at(term, ctx, q, -d)) / (2 * eps);
+    const double plus = energy_at(term, ctx, q, d);
+    g[i] = (plus - energy_at(term, ctx, q, -d)) / (2 * eps);
   }
   return g;
 }
