@@ -89,12 +89,15 @@ void ToolDriver::start(State& s) {
   state_.pose = sample_pose(device_now_);
   if (tool_->coupled())
     s.bodies[tool_->model_index] = {Configuration{{state_.pose}, VecX(0)}, Configuration{{state_.pose}, VecX(0)}};
-  if (!options_.record_dir.empty()) {
-    recorder_ = std::make_unique<teleop::PoseRecorder>(
-        (std::filesystem::path(options_.record_dir) / (name() + ".csv")).string());
-    recorder_->record({0, device_now_, 0.0});
-    recorded_ = device_now_;
-  }
+  start_recording(0.0);
+}
+
+void ToolDriver::start_recording(double t) {
+  if (options_.record_dir.empty()) return;
+  recorder_ = std::make_unique<teleop::PoseRecorder>(
+      (std::filesystem::path(options_.record_dir) / (name() + ".csv")).string());
+  recorder_->record({0, device_now_, t});
+  recorded_ = device_now_;
 }
 
 void ToolDriver::reset() {
@@ -116,12 +119,7 @@ void ToolDriver::resume(const Simulator& sim, double t, std::vector<std::vector<
   device_now_ = track_->at(t, hold_ ? PoseInterpolation::kHold : PoseInterpolation::kLinear);
   state_.device = device_now_;
   state_.pose = pose(sim);
-  if (!options_.record_dir.empty()) {
-    recorder_ = std::make_unique<teleop::PoseRecorder>(
-        (std::filesystem::path(options_.record_dir) / (name() + ".csv")).string());
-    recorder_->record({0, device_now_, t});
-    recorded_ = device_now_;
-  }
+  start_recording(t);
 }
 
 std::vector<std::vector<Anchor>> ToolDriver::grasped() const {

@@ -131,6 +131,8 @@ class ToolDriver {
   /// has keyframes or a pose file, else the tool is placed on the device's
   /// first pose (a coupled body with it, at rest).
   void take_over(Simulator& sim, double t0);
+  /// Opens the recording (options_.record_dir) with the device sample at t.
+  void start_recording(double t);
 
   const CompiledTool* tool_;
   ToolDriverOptions options_;

@@ -257,26 +257,25 @@ void ContactPatchTerm::prepare_patch_tets(TermCache& cache) const {
     c.cross_slot.insert(c.cross_slot.end(), s.begin(), s.end());
     c.cross_first.push_back(int(c.cross_slot.size()));
   }
+  // The pairs' indices, and the subspace share's stiffness summed per pair
+  // and over the patch DoFs (K0_pp).
   c.tet_cross.assign(c.tets.size(), {});
   c.node_cross.assign(c.cross_slot.size(), Mat3::Zero());
+  c.K0pp.setZero(3 * long(c.nodes.size()), 3 * long(c.nodes.size()));
   for (size_t i = 0; i < c.tets.size(); ++i)
     for (int k = 0; k < 4; ++k) {
-      const int n = c.tet_local[i][size_t(k)];
+      const int n = c.tet_local[i][size_t(k)], sk = c.tet_slot[i][size_t(k)];
       const auto first = c.cross_slot.begin() + c.cross_first[size_t(n)], last = c.cross_slot.begin() + c.cross_first[size_t(n) + 1];
       for (int l = 0; l < 4; ++l) {
         const int slot = c.tet_slot[i][size_t(l)];
         const int e = slot < 0 ? -1 : int(std::lower_bound(first, last, slot) - c.cross_slot.begin());
         c.tet_cross[i][size_t(4 * k + l)] = e;
-        if (e >= 0) c.node_cross[size_t(e)] += c.tet_K0[i][size_t(k)][size_t(l)];
+        if (e < 0) continue;
+        const Mat3& K0 = c.tet_K0[i][size_t(k)][size_t(l)];
+        c.node_cross[size_t(e)] += K0;
+        if (sk >= 0) c.K0pp.block<3, 3>(3 * sk, 3 * slot) += K0;
       }
     }
-  c.K0pp.setZero(3 * long(c.nodes.size()), 3 * long(c.nodes.size()));
-  for (size_t i = 0; i < c.tets.size(); ++i)
-    for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) {
-        const int sk = c.tet_slot[i][size_t(k)], sl = c.tet_slot[i][size_t(l)];
-        if (sk >= 0 && sl >= 0) c.K0pp.block<3, 3>(3 * sk, 3 * sl) += c.tet_K0[i][size_t(k)][size_t(l)];
-      }
 }
 
 // Σ_t (1 − α) κ_t V_t (Wᵀ b_t)(Wᵀ b_t)ᵀ over the patch tets (b_t the tet's

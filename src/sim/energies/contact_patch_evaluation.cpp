@@ -93,25 +93,19 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     const PatchCache& c = patch_cache(ctx, name());
     require(c.q_row_written.size() == size_t(nq) && (ob < 0 || c.q_row_written[size_t(ob)]), name(),
             ": the q blocks' rows were collected for another system (begin_step)");
-    const std::vector<int>& rows = c.q_rows_written;
-    const int z0 = L.z_offset();
-    if (out.Hqq.rows() != nq || out.Hqq.cols() != nq) {
-      out.Hqq.setZero(nq, nq);
-    } else {
-      for (int j : rows)
-        for (int i : rows) out.Hqq(i, j) = 0;
-    }
-    if (out.Hqp.rows() != nq || out.Hqp.cols() != np) {
-      out.Hqp.setZero(nq, np);
-    } else {
-      for (int r : rows) out.Hqp.row(r).setZero();
-    }
-    if (out.Hzp_stiffening.rows() != L.num_reduced || out.Hzp_stiffening.cols() != np) {
-      out.Hzp_stiffening.setZero(L.num_reduced, np);
-    } else {
-      for (int r : rows)
-        if (r >= z0 && r < z0 + L.num_reduced) out.Hzp_stiffening.row(r - z0).setZero();
-    }
+    // A block of another size is allocated zeroed; else its written rows
+    // (offset: the system's row of the block's first; square: and columns) are zeroed.
+    auto reset = [&](MatX& m, long rows, long cols, int offset, bool square) {
+      if (m.rows() != rows || m.cols() != cols) return void(m.setZero(rows, cols));
+      for (int r : c.q_rows_written) {
+        if (r < offset || r - offset >= rows) continue;
+        if (!square) m.row(r - offset).setZero();
+        else for (int j : c.q_rows_written) m(r, j) = 0;
+      }
+    };
+    reset(out.Hqq, nq, nq, 0, true);
+    reset(out.Hqp, nq, np, 0, false);
+    reset(out.Hzp_stiffening, L.num_reduced, np, L.z_offset(), false);
   }
   const double inertia = add_patch_inertia(ctx, q, du, mode, out);
   const double elasticity = add_patch_elasticity(ctx, q, du, mode, out);
