@@ -64,6 +64,29 @@ TEST(PatchCholesky, ANonzeroOutsideThePatternWidensIt) {
   EXPECT_LT((small * f.solve(ramp(6)) - ramp(6)).norm(), 1e-12 * ramp(6).norm());
 }
 
+TEST(PatchCholesky, ANonzeroMovedOrOnlyInTheSecondMatrixWidensThePattern) {
+  // Column 0 first holds (13, 0); then that entry is zero and (14, 0) is not:
+  // the column's nonzero count is unchanged, but one of them is new.
+  MatX A = chain(5, 0.7);
+  A(0, 13) = A(13, 0) = 1.5;
+  PatchCholesky f;
+  ASSERT_TRUE(f.factor(A));
+  A(0, 13) = A(13, 0) = 0.0;
+  A(0, 14) = A(14, 0) = -1.25;
+  ASSERT_TRUE(f.factor(A));
+  const VecX b = ramp(15);
+  EXPECT_LT((A * f.solve(b) - b).norm(), 1e-12 * b.norm());
+  // A nonzero of B alone (A + B couples nodes 1 and 3; A does not).
+  MatX B = MatX::Zero(15, 15);
+  B(4, 10) = B(10, 4) = 0.9;
+  B(5, 5) = 0.5;
+  ASSERT_TRUE(f.factor(A, &B, 1.0));
+  EXPECT_LT(((A + B) * f.solve(b) - b).norm(), 1e-12 * b.norm());
+  MatXr X;
+  f.half_solve(MatX::Identity(15, 15), X);  // XᵀX = (A + B)⁻¹
+  EXPECT_LT((X.transpose() * X * (A + B) - MatX::Identity(15, 15)).norm(), 1e-11);
+}
+
 TEST(PatchCholesky, HalfSolveGivesTheSchurComplement) {
   const MatX A = chain(4, 0.9);
   MatX C(12, 3);
@@ -71,7 +94,8 @@ TEST(PatchCholesky, HalfSolveGivesTheSchurComplement) {
     for (int j = 0; j < 3; ++j) C(i, j) = std::sin(1.0 + i + 3.0 * j);
   PatchCholesky f;
   ASSERT_TRUE(f.factor(A));
-  const MatX X = f.half_solve(C);
+  MatXr X(1, 1);  // storage of another shape: resized
+  f.half_solve(C, X);
   const MatX expected = C.transpose() * A.llt().solve(C);  // dense, independent
   EXPECT_LT((X.transpose() * X - expected).norm(), 1e-12 * expected.norm());
 }

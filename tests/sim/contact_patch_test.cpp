@@ -811,7 +811,9 @@ TEST(ContactPatch, ADynamicObjectGetsTheOppositeForceAndItsDerivativesMatchFinit
       if (collected[size_t(r)]) continue;
       EXPECT_EQ(c.start.Hqq.row(r).cwiseAbs().maxCoeff() + c.start.Hqq.col(r).cwiseAbs().maxCoeff(), 0) << r;
       EXPECT_EQ(c.Hqp.row(r).cwiseAbs().maxCoeff(), 0) << r;
-      if (r >= z0 && r < z0 + c.Hzp_stiffening.rows()) EXPECT_EQ(c.Hzp_stiffening.row(r - z0).cwiseAbs().maxCoeff(), 0) << r;
+      if (r >= z0 && r < z0 + c.Hzp_stiffening.rows()) {
+        EXPECT_EQ(c.Hzp_stiffening.row(r - z0).cwiseAbs().maxCoeff(), 0) << r;
+      }
     }
   }
   // The ball's generalized force is the reaction of the contact force on the body: −f along v.

@@ -477,17 +477,20 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   for (int j : c.q_rows)  // Φ_qq is zero outside these rows and columns
     for (int i : c.q_rows) (*hess)(i, j) += ev.Hqq(i, j);
   if (du.size() == 0 || c.releasing) return E;  // a prescribed δu: no condensation
-  // Schur complement over the rows of the layout the patch touches.
+  // Schur complement over the rows of the layout the patch touches (Φ_qp is
+  // column-major: its columns are scanned, and copied to C = Φ_pq's rows).
+  std::vector<char>& touched = c.schur_row;
+  touched.assign(size_t(ev.Hqp.rows()), 0);
+  for (int j = 0; j < ev.Hqp.cols(); ++j)
+    for (int r : c.q_rows)
+      if (ev.Hqp(r, j) != 0) touched[size_t(r)] = 1;
   std::vector<int> rows;
   for (int r : c.q_rows)
-    for (int j = 0; j < ev.Hqp.cols(); ++j)
-      if (ev.Hqp(r, j) != 0) {
-        rows.push_back(r);
-        break;
-      }
+    if (touched[size_t(r)]) rows.push_back(r);
   if (rows.empty()) return E;
-  MatX Hc(ev.Hqp.cols(), int(rows.size()));
-  for (size_t k = 0; k < rows.size(); ++k) Hc.col(int(k)) = ev.Hqp.row(rows[k]).transpose();
+  MatX& Hc = c.schur_C;
+  Hc.resize(ev.Hqp.cols(), long(rows.size()));
+  for (size_t k = 0; k < rows.size(); ++k) Hc.col(long(k)) = ev.Hqp.row(rows[k]).transpose();
   contact_patch_detail::PatchCholesky& llt = c.Hpp_llt;
   if (evaluated)
     std::swap(llt, c.start_llt);
@@ -519,14 +522,14 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
       if (r >= z0 && r < z0 + ev.Hzp_stiffening.rows()) (*grad)[r] -= ev.Hzp_stiffening.row(r - z0).dot(rest);
     }
   }
-  const MatX X = (relaxed ? guarded : llt).half_solve(Hc);
-  MatX S = MatX::Zero(X.cols(), X.cols());  // XᵀX, its lower half
+  MatXr& X = c.schur_X;
+  (relaxed ? guarded : llt).half_solve(Hc, X);
+  MatX& S = c.schur_S;  // XᵀX, its lower half, then mirrored
+  S.setZero(X.cols(), X.cols());
   S.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
+  S.triangularView<Eigen::StrictlyUpper>() = S.transpose();
   for (size_t l = 0; l < rows.size(); ++l)
-    for (size_t k = l; k < rows.size(); ++k) {
-      (*hess)(rows[k], rows[l]) -= S(int(k), int(l));
-      if (k != l) (*hess)(rows[l], rows[k]) -= S(int(k), int(l));
-    }
+    for (size_t k = 0; k < rows.size(); ++k) (*hess)(rows[k], rows[l]) -= S(long(k), long(l));
   // Kept for the trials: Φ_pq with the dented tets' own stiffness (the complement takes K0's).
   c.Hqp.swap(ev.Hqp);  // the evaluation gets the last linearization's storage back
   c.Hzp_stiffening.swap(ev.Hzp_stiffening);

@@ -148,6 +148,11 @@ struct PatchCache : TermCache {
   // a Newton iteration's start, and the inner Newton iteration's point and trial.
   ContactPatchTerm::Evaluation start, inner, inner_trial;
   PatchCholesky below_llt, guarded_llt;  // the complement's guard (compute)
+  // The complement's scratch (compute): the rows of Φ_pq it reads, X = L⁻¹ P Φ_pq
+  // and XᵀX (kept: at a few hundred kB fresh pages cost more than the products).
+  std::vector<char> schur_row;
+  MatX schur_C, schur_S;
+  MatXr schur_X;
   PatchCholesky inner_llt;               // the inner Newton iteration's Φ_pp (minimize_patch)
   // The step's last trial: its configuration, δu and evaluation.
   bool has_trial = false;

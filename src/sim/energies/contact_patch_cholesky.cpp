@@ -1,40 +1,103 @@
 #include "sim/energies/contact_patch_cholesky.hpp"
 
+#include <algorithm>
 #include <vector>
 
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
+
+#include "sflsh/core/error.hpp"
 
 namespace sflsh::contact_patch_detail {
 
 struct PatchCholesky::Impl {
+  using Sparse = Eigen::SparseMatrix<double>;
   long n = 0;
   bool ok = false;
   bool analyzed = false;
-  std::vector<int> slot;  // dense lower entry (column-major) → index into lower's values, or −1
-  Eigen::SparseMatrix<double> lower;
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  // The fill-reducing ordering, kept with the pattern: the factored matrix is
+  // M = P A Pᵀ, stored permuted (its upper triangle, which the factorization
+  // reads in place, so a factorization does not permute the matrix again).
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P;
+  Sparse upper;
+  // The pattern by the dense matrix's lower columns: for column j, the entries
+  // first[j] .. first[j + 1] − 1, each the dense row i ≥ j and the position of
+  // M's entry (P(i), P(j)) in upper's values.
+  std::vector<int> first, row, value;
+  Eigen::SimplicialLLT<Sparse, Eigen::Upper, Eigen::NaturalOrdering<int>> llt;
 
   // The pattern: the diagonal, the nonzeros of A's and B's lower triangles
   // and, for a matrix of the same size, the last pattern (patterns only widen
   // while the patch keeps its size, so the analysis is redone rarely).
   void analyze(const MatX& A, const MatX* B) {
     const long size = A.rows();
-    const bool widen = analyzed && long(slot.size()) == size * size;
+    const bool widen = analyzed && n == size;
     std::vector<Eigen::Triplet<double>> entries;
-    for (long j = 0; j < size; ++j)
-      for (long i = j; i < size; ++i)
-        if (i == j || A(i, j) != 0 || (B && (*B)(i, j) != 0) || (widen && slot[size_t(j * size + i)] >= 0))
-          entries.emplace_back(int(i), int(j), 0.0);
-    lower.resize(size, size);
+    for (long j = 0; j < size; ++j) {
+      long e = widen ? first[size_t(j)] : 0;
+      for (long i = j; i < size; ++i) {
+        const bool before = widen && e < first[size_t(j) + 1] && row[size_t(e)] == i;
+        if (before) ++e;
+        if (i == j || A(i, j) != 0 || (B && (*B)(i, j) != 0) || before) entries.emplace_back(int(i), int(j), 1.0);
+      }
+    }
+    Sparse lower(size, size);
     lower.setFromTriplets(entries.begin(), entries.end());
-    lower.makeCompressed();
-    slot.assign(size_t(size * size), -1);
-    for (long j = 0; j < size; ++j)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(lower, j); it; ++it)
-        slot[size_t(j * size + it.row())] = int(&it.valueRef() - lower.valuePtr());
-    llt.analyzePattern(lower);
+    // The ordering Eigen's SimplicialLLT would choose (AMD on the full pattern).
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P_inverse;
+    const Sparse full = lower.selfadjointView<Eigen::Lower>();
+    Eigen::AMDOrdering<int>()(full, P_inverse);
+    P = P_inverse.inverse();
+    const auto& to = P.indices();  // dense index i → M's index to[i]
+    std::vector<Eigen::Triplet<double>> permuted;
+    permuted.reserve(entries.size());
+    for (const auto& t : entries) {
+      const int a = to[t.row()], b = to[t.col()];
+      permuted.emplace_back(std::min(a, b), std::max(a, b), 1.0);
+    }
+    upper.resize(size, size);
+    upper.setFromTriplets(permuted.begin(), permuted.end());
+    upper.makeCompressed();
+    first.assign(size_t(size) + 1, 0);
+    row.resize(entries.size());
+    value.resize(entries.size());
+    for (size_t k = 0; k < entries.size(); ++k) {  // the triplets are in column order, rows increasing
+      const int i = entries[k].row(), j = entries[k].col();
+      ++first[size_t(j) + 1];
+      row[k] = i;
+      value[k] = int(position(to[i], to[j]));
+    }
+    for (long j = 0; j < size; ++j) first[size_t(j) + 1] += first[size_t(j)];
+    llt.analyzePattern(upper);
     analyzed = true;
     n = size;
+  }
+
+  // The position of M's entry (a, b) (or (b, a)) in upper's values.
+  long position(int a, int b) const {
+    if (a > b) std::swap(a, b);
+    const int* begin = upper.innerIndexPtr() + upper.outerIndexPtr()[b];
+    const int* end = upper.innerIndexPtr() + upper.outerIndexPtr()[b + 1];
+    return long(std::lower_bound(begin, end, a) - upper.innerIndexPtr());
+  }
+
+  // Writes A + sign B + shift I into M's values; false when a nonzero of A or
+  // B lies outside the pattern (counted per column, which vectorizes).
+  bool fill(const MatX& A, const MatX* B, double sign, double shift) {
+    double* values = upper.valuePtr();
+    for (long j = 0; j < n; ++j) {
+      long inside = 0;  // the pattern's entries of this column where A or B is nonzero
+      for (int e = first[size_t(j)]; e < first[size_t(j) + 1]; ++e) {
+        const long i = row[size_t(e)];
+        const double a = A(i, j), b = B ? (*B)(i, j) : 0.0;
+        inside += (a != 0 || b != 0);
+        values[value[size_t(e)]] = a + sign * b + (i == j ? shift : 0.0);
+      }
+      const auto a = A.col(j).tail(n - j).array();
+      const long nonzero = B ? ((a != 0) || (B->col(j).tail(n - j).array() != 0)).count() : (a != 0).count();
+      if (nonzero != inside) return false;
+    }
+    return true;
   }
 };
 
@@ -46,18 +109,21 @@ PatchCholesky::PatchCholesky(const PatchCholesky& other) : PatchCholesky() { *th
 
 PatchCholesky& PatchCholesky::operator=(const PatchCholesky& other) {
   if (this == &other) return *this;
+  if (!other.impl_) return *this = PatchCholesky();
   if (!impl_) impl_ = std::make_unique<Impl>();
   Impl& d = *impl_;
-  if (!other.impl_) return *this = PatchCholesky();
   const Impl& s = *other.impl_;
   d.n = s.n;
-  d.slot = s.slot;
-  d.lower = s.lower;
+  d.P = s.P;
+  d.upper = s.upper;
+  d.first = s.first;
+  d.row = s.row;
+  d.value = s.value;
   d.analyzed = s.analyzed;
   d.ok = false;
   if (d.analyzed) {
-    d.llt.analyzePattern(d.lower);
-    if (s.ok) d.llt.factorize(d.lower), d.ok = d.llt.info() == Eigen::Success;
+    d.llt.analyzePattern(d.upper);
+    if (s.ok) d.llt.factorize(d.upper), d.ok = d.llt.info() == Eigen::Success;
   }
   return *this;
 }
@@ -65,35 +131,36 @@ PatchCholesky& PatchCholesky::operator=(const PatchCholesky& other) {
 bool PatchCholesky::factor(const MatX& A, const MatX* B, double sign, double shift) {
   if (!impl_) impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
-  const long n = A.rows();
-  if (!m.analyzed || n != m.n) m.analyzed = false, m.analyze(A, B);
-  double* values = m.lower.valuePtr();
-  for (long j = 0; j < n; ++j)
-    for (long i = j; i < n; ++i) {
-      double v = A(i, j);
-      if (B) v += sign * (*B)(i, j);
-      if (i == j) v += shift;
-      const int s = m.slot[size_t(j * n + i)];
-      if (s >= 0) {
-        values[s] = v;
-      } else if (v != 0) {  // outside the analysed pattern: widen it and start over
-        m.analyze(A, B);
-        return factor(A, B, sign, shift);
-      }
-    }
-  m.llt.factorize(m.lower);
+  if (!m.analyzed || A.rows() != m.n) m.analyzed = false, m.analyze(A, B);
+  if (!m.fill(A, B, sign, shift)) {  // outside the analysed pattern: widen it
+    m.analyze(A, B);
+    require(m.fill(A, B, sign, shift), "PatchCholesky: the pattern does not hold the matrix after its analysis");
+  }
+  m.llt.factorize(m.upper);
   m.ok = m.llt.info() == Eigen::Success;
   return m.ok;
 }
 
 bool PatchCholesky::ok() const { return impl_ && impl_->ok; }
 long PatchCholesky::rows() const { return ok() ? impl_->n : 0; }
-VecX PatchCholesky::solve(const VecX& b) const { return impl_->llt.solve(b); }
 
-MatX PatchCholesky::half_solve(const MatX& C) const {
-  MatX X = impl_->llt.permutationP() * C;
-  impl_->llt.matrixL().solveInPlace(X);
-  return X;
+VecX PatchCholesky::solve(const VecX& b) const {
+  const Impl& m = *impl_;
+  return m.P.transpose() * m.llt.solve(m.P * b);  // A⁻¹ = Pᵀ M⁻¹ P
+}
+
+void PatchCholesky::half_solve(const MatX& C, MatXr& X) const {
+  const Impl& m = *impl_;
+  X.resize(C.rows(), C.cols());
+  const auto& to = m.P.indices();  // (P C)(to[i], :) = C(i, :)
+  for (long i = 0; i < C.rows(); ++i) X.row(to[i]) = C.row(i);
+  // L column by column (the diagonal first in each column of a Cholesky factor).
+  const Impl::Sparse& L = m.llt.matrixL().nestedExpression();
+  for (long j = 0; j < L.outerSize(); ++j) {
+    Impl::Sparse::InnerIterator it(L, j);
+    X.row(j) /= it.value();
+    for (++it; it; ++it) X.row(it.index()) -= it.value() * X.row(j);
+  }
 }
 
 }  // namespace sflsh::contact_patch_detail

@@ -30,8 +30,10 @@ class PatchCholesky {
   long rows() const;
   /// M⁻¹ b for the factored matrix M.
   VecX solve(const VecX& b) const;
-  /// X = L⁻¹ P C for M = Pᵀ L Lᵀ P: XᵀX = Cᵀ M⁻¹ C.
-  MatX half_solve(const MatX& C) const;
+  /// X = L⁻¹ P C for M = Pᵀ L Lᵀ P: XᵀX = Cᵀ M⁻¹ C. X is row-major (its
+  /// storage reused): the forward substitution updates whole rows, one vector
+  /// operation per nonzero of L.
+  void half_solve(const MatX& C, MatXr& X) const;
 
  private:
   struct Impl;

@@ -97,11 +97,14 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
     // (offset: the system's row of the block's first; square: and columns) are zeroed.
     auto reset = [&](MatX& m, long rows, long cols, int offset, bool square) {
       if (m.rows() != rows || m.cols() != cols) return void(m.setZero(rows, cols));
-      for (int r : c.q_rows_written) {
-        if (r < offset || r - offset >= rows) continue;
-        if (!square) m.row(r - offset).setZero();
-        else for (int j : c.q_rows_written) m(r, j) = 0;
-      }
+      auto zero_rows = [&](long j) {  // column j's written rows (column-major: down the column)
+        for (int r : c.q_rows_written)
+          if (r >= offset && r - offset < rows) m(r - offset, j) = 0;
+      };
+      if (square)
+        for (int j : c.q_rows_written) zero_rows(j);
+      else
+        for (long j = 0; j < cols; ++j) zero_rows(j);
     };
     reset(out.Hqq, nq, nq, 0, true);
     reset(out.Hqp, nq, np, 0, false);
