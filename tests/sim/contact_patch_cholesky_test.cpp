@@ -87,6 +87,37 @@ TEST(PatchCholesky, ANonzeroMovedOrOnlyInTheSecondMatrixWidensThePattern) {
   EXPECT_LT((X.transpose() * X * (A + B) - MatX::Identity(15, 15)).norm(), 1e-11);
 }
 
+TEST(PatchCholesky, FactorsShareOnePatternAndKeepTheirOwnOrdering) {
+  using contact_patch_detail::PatchPattern;
+  const MatX A = chain(5, 0.7);
+  const VecX b = ramp(15);
+  PatchPattern pattern;
+  PatchCholesky f, g;
+  ASSERT_TRUE(f.factor(pattern, A));
+  const MatX B = chain(5, 0.2) * 0.3;  // within the chain's pattern
+  ASSERT_TRUE(g.factor(pattern, A, &B, -1.0));
+  EXPECT_EQ(pattern.analyses(), 1);  // the second factor reused the first's analysis
+  // g widens the shared pattern; f's factor, made on the old one, still solves A.
+  MatX C = A;
+  C(0, 13) = C(13, 0) = 1.5;
+  ASSERT_TRUE(g.factor(pattern, C));
+  EXPECT_EQ(pattern.analyses(), 2);
+  EXPECT_LT((A * f.solve(b) - b).norm(), 1e-12 * b.norm());
+  EXPECT_LT((C * g.solve(b) - b).norm(), 1e-12 * b.norm());
+  ASSERT_TRUE(f.factor(pattern, A));  // on the widened pattern
+  EXPECT_EQ(pattern.analyses(), 2);
+  EXPECT_LT((A * f.solve(b) - b).norm(), 1e-12 * b.norm());
+  // Another size starts over; a copied pattern is read again by its factors.
+  const MatX small = chain(2, 0.3);
+  PatchPattern copy = pattern;
+  ASSERT_TRUE(f.factor(copy, A));
+  EXPECT_LT((A * f.solve(b) - b).norm(), 1e-12 * b.norm());
+  ASSERT_TRUE(f.factor(pattern, small));
+  EXPECT_EQ(pattern.analyses(), 3);
+  EXPECT_EQ(f.rows(), 6);
+  EXPECT_LT((small * f.solve(ramp(6)) - ramp(6)).norm(), 1e-12 * ramp(6).norm());
+}
+
 TEST(PatchCholesky, HalfSolveGivesTheSchurComplement) {
   const MatX A = chain(4, 0.9);
   MatX C(12, 3);

@@ -491,11 +491,12 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   MatX& Hc = c.schur_C;
   Hc.resize(ev.Hqp.cols(), long(rows.size()));
   for (size_t k = 0; k < rows.size(); ++k) Hc.col(long(k)) = ev.Hqp.row(rows[k]).transpose();
+  require(ev.has_Hpp, name(), ": the condensation needs the evaluation's Φ_pp");
   contact_patch_detail::PatchCholesky& llt = c.Hpp_llt;
   if (evaluated)
     std::swap(llt, c.start_llt);
   else
-    llt.factor(ev.Hpp);
+    llt.factor(c.pattern, ev.Hpp);
   require(llt.ok(), name(), ": the patch's Hessian is not positive definite");
   // The complement must stay below what the other terms carry for these DoFs
   // (Wᵀ K0 W over the patch tets, the nodes' inertia, the contact): by the
@@ -507,8 +508,8 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   // which is ⪰ K0_pp + M + C because K1 is PSD-projected. Only the Hessian
   // changes; in the first case it is as before.
   contact_patch_detail::PatchCholesky &below = c.below_llt, &guarded = c.guarded_llt;
-  const bool relaxed = !below.factor(ev.Hpp, &c.K0pp, -1.0, 1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff());
-  require(!relaxed || guarded.factor(ev.Hpp, &c.K0pp, 1.0), name(), ": the patch's guarded Hessian is not positive definite");
+  const bool relaxed = !below.factor(c.pattern, ev.Hpp, &c.K0pp, -1.0, 1e-9 * ev.Hpp.diagonal().cwiseAbs().maxCoeff());
+  require(!relaxed || guarded.factor(c.pattern, ev.Hpp, &c.K0pp, 1.0), name(), ": the patch's guarded Hessian is not positive definite");
   c.linearized = true;
   c.q_lin = q;
   if (dynamic_) c.object_lin = *ctx.bound[1].q;

@@ -91,8 +91,9 @@ double ContactPatchTerm::add_patch_anchors(const StepContext& ctx, const Configu
     for (const auto& [pi, bi] : pv.couple) {
       if (pi < 0 || bi == 0.0) continue;
       out.gp.segment<3>(3 * pi) += bi * pv.A.transpose() * g;
-      for (const auto& [pj, bj] : pv.couple)
-        if (pj >= 0 && bj != 0.0) out.Hpp.block<3, 3>(3 * pi, 3 * pj) += kappa * bi * bj * pv.A.transpose() * pv.A;
+      if (out.has_Hpp)
+        for (const auto& [pj, bj] : pv.couple)
+          if (pj >= 0 && bj != 0.0) out.Hpp.block<3, 3>(3 * pi, 3 * pj) += kappa * bi * bj * pv.A.transpose() * pv.A;
     }
     if (!q_derivatives) continue;
     add_offset_rotation_gradient(a.surface_weights.row(v), q.bones, pv.offset, g, L, out.gq);

@@ -18,7 +18,8 @@ namespace sflsh {
 struct ContactPatchTerm::Evaluation {
   double energy = 0;
   VecX gp;   // ∂Φ/∂δu
-  MatX Hpp;  // its PSD approximation
+  MatX Hpp;  // its PSD approximation (this evaluation's when has_Hpp: else the storage of an earlier one)
+  bool has_Hpp = false;
   VecX gq;   // ∂Φ/∂q
   MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
   MatX Hqp;  // cross block (layout rows by patch DoFs)
@@ -132,6 +133,7 @@ struct PatchCache : TermCache {
   // Φ_pq = Hqpᵀ + the dented tets' stiffening of its z columns (z_lin: their offset).
   MatX Hqp, Hzp_stiffening;
   int z_lin = 0;
+  PatchPattern pattern;  // the pattern and ordering of every factor below (one analysis per patch size)
   PatchCholesky Hpp_llt;
   PatchCholesky start_llt;  // Φ_pp's factor at a Newton iteration's start (minimize_patch)
   /// Φ_pp⁻¹ Φ_pq dq at the last linearization (dq over the term's layout).

@@ -83,7 +83,8 @@ double ContactPatchTerm::evaluate_patch(const StepContext& ctx, const Configurat
   out.gp = std::move(gp);
   out.gp.setZero(np);
   out.Hpp = std::move(Hpp);
-  out.Hpp.setZero(np, np);
+  out.has_Hpp = mode.pp_hessian();
+  if (out.has_Hpp) out.Hpp.setZero(np, np);
   if (q_derivatives) (out.gq = std::move(gq)).setZero(nq);
   out.Hqq = std::move(Hqq);
   out.Hqp = std::move(Hqp);
@@ -142,7 +143,7 @@ double ContactPatchTerm::add_patch_inertia(const StepContext& ctx, const Configu
     if (!p_derivatives) continue;
     const Vec3 fd = m * inv_h2 * (r + e) - m * ctx.gravity;  // ∂Φ/∂d
     out.gp.segment<3>(3 * i) += A[i].transpose() * fd;
-    out.Hpp.block<3, 3>(3 * i, 3 * i) += m * inv_h2 * A[i].transpose() * A[i];
+    if (out.has_Hpp) out.Hpp.block<3, 3>(3 * i, 3 * i) += m * inv_h2 * A[i].transpose() * A[i];
     if (!q_derivatives) continue;
     add_offset_rotation_gradient(a.node_weights.row(n), q.bones, du.segment<3>(3 * i), fd, L, out.gq);
     nodes_.local_jacobian(n, q, L, J, cols);
@@ -203,7 +204,7 @@ double ContactPatchTerm::add_patch_elasticity(const StepContext& ctx, const Conf
                                               const EvaluationMode& mode, Evaluation& out) const {
   const bool q_derivatives = mode.q_derivatives, p_derivatives = mode.p_derivatives || mode.q_derivatives;
   const bool q_hessian = q_derivatives && mode.q_hessian;
-  const bool hessian = mode.p_derivatives || q_hessian;  // a gradient alone (a trial's) needs no element Hessian
+  const bool hessian = mode.pp_hessian();  // a gradient alone (a trial's) needs no element Hessian
   const bool subspace = mode.subspace_energy || q_derivatives;
   PatchCache& c = patch_cache(ctx, name());
   const Avatar& a = *avatar_;
@@ -330,7 +331,9 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   // Per vertex (slot): g_v = Σ_s λ_v g_s, and per vertex pair M_vw = Σ_s λ_v λ_w H_s
   // over the touching samples of their faces; the Jacobians are applied once per vertex pair.
   std::vector<Vec3> gv(p_derivatives ? nv : 0, Vec3::Zero());
-  std::unordered_map<long, Mat3> Mvw;
+  std::unordered_map<long, Mat3> Mvw;  // with Φ_pp (EvaluationMode::pp_hessian)
+  std::vector<char> touched(nv, 0);     // a vertex of a touching sample's face
+  bool touching_any = false;
   for (size_t fi = 0; fi < c.faces.size(); ++fi) {
     const int fc = c.faces[fi];
     std::array<int, 3> vs;
@@ -365,7 +368,8 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       const Mat3 H = k * nrm * nrm.transpose();
       for (int i = 0; i < 3; ++i) {
         g[i] += smp.lambda[i] * k * d * nrm;
-        for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
+        if (out.has_Hpp)
+          for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
       }
       if (ob < 0 || !q_derivatives) continue;
       Mat63 JoT;  // J_oᵀ
@@ -377,13 +381,16 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
     }
     if (!touching) continue;
+    touching_any = true;
     for (int i = 0; i < 3; ++i) {
+      touched[vs[i]] = 1;
       gv[vs[i]] += g[i];
-      for (int j = 0; j < 3; ++j)
+      if (out.has_Hpp)
+        for (int j = 0; j < 3; ++j)
         Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
     }
   }
-  if (!p_derivatives || Mvw.empty()) return E;
+  if (!p_derivatives || !touching_any) return E;
   // Patch DoFs: ∂x_v/∂δu_c = b_vc A_v.
   for (size_t v = 0; v < nv; ++v)
     for (const auto& [pi, bi] : couple[v])
@@ -401,8 +408,6 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   // Subspace DoFs: ∂x_v/∂q = J_v (and the offsets' rotation with the bones).
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> Jv(nv);
   std::vector<std::vector<int>> cv(nv);
-  std::vector<char> touched(nv, 0);
-  for (const auto& [key, M] : Mvw) touched[size_t(key / long(nv))] = 1;
   for (size_t v = 0; v < nv; ++v) {
     if (!touched[v]) continue;
     vertices_.local_jacobian(c.vertices[v], q, L, Jv[v], cv[v]);

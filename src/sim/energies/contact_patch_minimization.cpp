@@ -98,7 +98,7 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     EvaluationMode full;
     full.q_derivatives = full.q_hessian = true;
     const double E = evaluate_patch(ctx, q, du, full, *start);
-    if (std::isfinite(E) && c.start_llt.factor(start->Hpp) &&
+    if (std::isfinite(E) && c.start_llt.factor(c.pattern, start->Hpp) &&
         (start->gp.norm() < 1e-12 || c.start_llt.solve(start->gp).cwiseAbs().maxCoeff() <= options_.inner_tolerance)) {
       c.du = du;
       c.solved = true;
@@ -134,14 +134,15 @@ VecX ContactPatchTerm::minimize_patch(const StepContext& ctx, const Configuratio
     if (!std::isfinite(E0)) break;
     if (ev.gp.norm() < 1e-12) break;
     PatchCholesky& llt = c.inner_llt;
-    if (!llt.factor(ev.Hpp)) {
+    require(ev.has_Hpp, name(), ": the inner Newton step needs the evaluation's Φ_pp");
+    if (!llt.factor(c.pattern, ev.Hpp)) {
       EvaluationMode projected = exact;
       projected.project = true;
       evaluate_patch(ctx, q, du, projected, ev);
-      if (!llt.factor(ev.Hpp)) {
+      if (!llt.factor(c.pattern, ev.Hpp)) {
         // PSD by construction and PD with mass: only a degenerate tet gets here.
         ev.Hpp.diagonal() *= 1.0 + 1e-8;
-        require(llt.factor(ev.Hpp), name(), ": the patch's Hessian is not positive definite");
+        require(llt.factor(c.pattern, ev.Hpp), name(), ": the patch's Hessian is not positive definite");
       }
     }
     const VecX step = llt.solve(-ev.gp);

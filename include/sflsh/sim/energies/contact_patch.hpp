@@ -241,6 +241,9 @@ class ContactPatchTerm : public EnergyTerm {
     bool p_derivatives = true;    ///< ∂Φ/∂δu and Φ_pp
     bool project = true;          ///< PSD-projected element Hessians (else exact)
     bool subspace_energy = true;  ///< include −Σ V Ψ(F(Wz)) (constant in δu)
+    /// Φ_pp is formed: asked for, or for the condensation of Φ_qq (a
+    /// gradient-only evaluation, a trial's, leaves it out).
+    bool pp_hessian() const { return p_derivatives || (q_derivatives && q_hessian); }
   };
   double evaluate_patch(const StepContext& ctx, const Configuration& q, const VecX& du, const EvaluationMode& mode,
                         Evaluation& out) const;
