@@ -525,12 +525,11 @@ double ContactPatchTerm::compute(const StepContext& ctx, const Configuration& q,
   }
   MatXr& X = c.schur_X;
   (relaxed ? guarded : llt).half_solve(Hc, X);
-  MatX& S = c.schur_S;  // XᵀX, its lower half, then mirrored
+  MatX& S = c.schur_S;  // XᵀX, its lower half
   S.setZero(X.cols(), X.cols());
   S.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
-  S.triangularView<Eigen::StrictlyUpper>() = S.transpose();
-  for (size_t l = 0; l < rows.size(); ++l)
-    for (size_t k = 0; k < rows.size(); ++k) (*hess)(rows[k], rows[l]) -= S(long(k), long(l));
+  for (size_t l = 0; l < rows.size(); ++l)  // down the step Hessian's columns
+    for (size_t k = 0; k < rows.size(); ++k) (*hess)(rows[k], rows[l]) -= k >= l ? S(long(k), long(l)) : S(long(l), long(k));
   // Kept for the trials: Φ_pq with the dented tets' own stiffness (the complement takes K0's).
   c.Hqp.swap(ev.Hqp);  // the evaluation gets the last linearization's storage back
   c.Hzp_stiffening.swap(ev.Hzp_stiffening);

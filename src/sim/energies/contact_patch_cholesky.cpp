@@ -171,7 +171,8 @@ struct PatchPattern::Impl {
             inside[b] += (A(3 * i + a, 3 * j + b) != 0 || (B && (*B)(3 * i + a, 3 * j + b) != 0));
         if (i == j) {  // the lower triangle is read
           block.diagonal().array() += shift;
-          block = block.selfadjointView<Eigen::Lower>();
+          const Mat3 lower_part = block;
+          block = lower_part.selfadjointView<Eigen::Lower>();
         }
         L[size_t(a_position[size_t(e)])] = a_transposed[size_t(e)] ? Mat3(block.transpose()) : block;
       }

@@ -3,7 +3,7 @@
 // block Φ_pp (and of the guard's Φ_pp ∓ K0_pp), which the evaluation
 // assembles densely. The block couples only nodes that share a patch tet or a
 // touching face: the factor of a 76-node patch (228 DoFs) holds ~20 % of the
-// dense one's entries.
+// dense one's entries. It is factored in 3x3 node blocks (3 DoFs per node).
 #include <memory>
 
 #include "sflsh/core/types.hpp"
@@ -35,7 +35,7 @@ class PatchCholesky {
  public:
   PatchCholesky();
   ~PatchCholesky();
-  /// A copy factors the copied values again (the same factor, bit for bit).
+  /// A copy holds the same factor (bit for bit) on a copy of its structure.
   PatchCholesky(const PatchCholesky& other);
   PatchCholesky& operator=(const PatchCholesky& other);
   PatchCholesky(PatchCholesky&&) noexcept;
