@@ -51,7 +51,8 @@
 // Condensation (Teng et al. 2015, "Subspace condensation"): the term's energy
 // is E(q) = min_δu Φ(q, δu), the patch minimized out at every evaluation
 // (Newton on δu with q fixed: a small sparse system, factored by a sparse
-// Cholesky whose analysis is kept while its pattern holds; a few iterations).
+// Cholesky in 3x3 node blocks whose ordering is shared by the patch's factors
+// and kept while its pattern holds; a few iterations).
 // Then ∂E/∂q = ∂Φ/∂q at the minimizer (envelope theorem) and the Hessian is
 // the Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq over the rows the patch
 // touches, so the global step stays one Newton step over bones and handles.
