@@ -387,7 +387,7 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       gv[vs[i]] += g[i];
       if (out.has_Hpp)
         for (int j = 0; j < 3; ++j)
-        Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
+          Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
     }
   }
   if (!p_derivatives || !touching_any) return E;
