@@ -150,6 +150,156 @@ void summarize(SceneContactPair& p, double threshold) {
     if (std::isfinite(d)) p.max_depth_mm = std::isfinite(p.max_depth_mm) ? std::max(p.max_depth_mm, d) : d;
 }
 
+/// The full-FEM reference's run of the scene: per step its time, whether any
+/// partner touches, and per partner the force and position (the forces and
+/// dents also into res.pairs, the times into res.time).
+struct ReferenceTrace {
+  std::vector<double> ms;
+  std::vector<bool> contact;
+  std::vector<std::vector<Vec3>> force, position;
+};
+
+ReferenceTrace run_reference(const SceneDescription& sc, const std::vector<Partner>& partners,
+                             const SceneContactBenchSettings& set, SceneContactBenchResult& res) {
+  const std::string& where = res.scene;
+  const size_t np = partners.size();
+  size_t n_obstacles = 0;  // the partners with a shape come first (contact_partners)
+  for (const Partner& p : partners) n_obstacles += p.grasp_tool < 0;
+  ReferenceTrace t;
+  t.force.resize(np);
+  t.position.resize(np);
+  SceneReferenceOptions ro;
+  ro.progress = set.progress;
+  ro.on_step = [&](const SceneReferenceStep& s) {
+    const FullFemReport& rep = *s.report;
+    require(rep.contacts.size() == n_obstacles, where, ": the full-FEM reference has ", rep.contacts.size(),
+            " obstacles, expected ", n_obstacles);
+    require(s.fem->displacement().allFinite(), where, ": the full-FEM reference became non-finite at step ", s.step,
+            " (t = ", s.time, " s)");
+    const Points x = s.fem->posed_surface(), u = s.fem->soft_displacement();
+    bool any = false;
+    for (size_t i = 0; i < np; ++i) {
+      const int tool = partners[i].grasp_tool;
+      const Vec3 f = tool < 0 ? rep.contacts[i].force : s.tool_forces->at(size_t(tool));
+      const Isometry& pose = tool < 0 ? s.obstacle_poses->at(i) : s.tool_poses->at(size_t(tool));
+      require(f.allFinite(), where, ": the full-FEM ", tool < 0 ? "contact" : "grasp", " force of '", partners[i].name,
+              "' became non-finite at step ", s.step, " (t = ", s.time, " s)");
+      t.force[i].push_back(f);
+      t.position[i].push_back(pose.translation());
+      res.pairs[i].force_full_n.push_back(f.norm());
+      res.pairs[i].dent_full_mm.push_back(1e3 * near_dent(x, u, *partners[i].field, pose, set.dent_reach));
+      any = any || f.norm() > 0;
+    }
+    res.time.push_back(s.time);
+    t.ms.push_back(set.cpu_time ? s.cpu_ms : rep.ms_total);
+    t.contact.push_back(any);
+  };
+  log_info("bench-contact: " + where + ": full-FEM reference");
+  run_scene_reference(sc, ro);
+  return t;
+}
+
+/// The reduced solver's run of the scene as `sflsh simulate` runs it: per
+/// step its time and whether any partner touches (the forces, dents and patch
+/// sizes into res.pairs).
+struct ReducedTrace {
+  std::vector<double> ms;
+  std::vector<bool> contact;
+};
+
+ReducedTrace run_reduced(const SceneDescription& sc, const std::vector<Partner>& partners,
+                         const SceneContactBenchSettings& set, SceneContactBenchResult& res) {
+  const std::string& where = res.scene;
+  const size_t np = partners.size();
+  ReducedTrace t;
+  std::vector<double>& ms_with = t.ms;
+  std::vector<bool>& contact_with = t.contact;
+  SceneSessionOptions so;
+  so.progress = set.progress;
+  so.inject_nan_at_step = set.inject_nan_at_step;
+  SceneSession session(sc, so);
+  const SimulationResult header = session.result_header();
+  std::vector<int> object_index(np, -1);
+  for (size_t i = 0; i < np; ++i)
+    for (size_t j = 0; j < header.objects.size(); ++j)
+      if (header.objects[j].name == partners[i].name) object_index[i] = int(j);
+  const int body = session.body_model_index(0);
+  for (const Partner& p : partners)
+    require(p.grasp_tool < 0 || session.tool_index(p.name) == p.grasp_tool, where, ": tools '", p.name,
+            "' is not the scene's tool ", p.grasp_tool);
+  SceneRunOptions ro;
+  ro.progress = set.progress;
+  ro.keep_frames = false;
+  StepClock clock(set.cpu_time);
+  ro.on_step = [&](const Simulator&, const StepReport& rep) {
+    ms_with.push_back(clock.lap());
+    const FrameData fr = session.frame(0.0);  // skin with the patches' dents; one body: its rows
+    const std::vector<Isometry> poses = session.object_poses();
+    bool any = false;
+    for (size_t i = 0; i < np; ++i) {
+      const std::string term = "contact:" + partners[i].name;
+      double force = 0;
+      int nodes = 0;
+      const int tool = partners[i].grasp_tool;
+      for (const TermQuantityReport& q : rep.quantities) {
+        if (q.body != body) continue;
+        if (tool >= 0) {  // a grasping tool's patch: its anchor terms'
+          const std::vector<int>& at = session.compiled_tool(tool).anchor_terms;
+          if (q.name == "patch_nodes" && q.value.size() == 1 && std::count(at.begin(), at.end(), q.term_index))
+            nodes = std::max(nodes, int(q.value[0]));
+          continue;
+        }
+        if (q.term != term) continue;
+        if (q.name == "force" && q.value.size() == 3) force = Vec3(q.value[0], q.value[1], q.value[2]).norm();
+        if (q.name == "patch_nodes" && q.value.size() == 1) nodes = int(q.value[0]);
+      }
+      if (tool >= 0) force = session.tool_state(tool).force.norm();  // on the tool: its anchors
+      require(std::isfinite(force), where, ": the reduced ", tool < 0 ? "contact" : "grasp", " force of '",
+              partners[i].name, "' became non-finite at step ", ms_with.size());
+      SceneContactPair& p = res.pairs[i];
+      p.force_reduced_n.push_back(force);
+      p.patch_nodes.push_back(nodes);
+      const bool placed = tool >= 0 || object_index[i] >= 0;
+      const Isometry pose = tool >= 0 ? session.tool_state(tool).pose
+                                      : object_index[i] >= 0 ? poses.at(size_t(object_index[i])) : Isometry::Identity();
+      p.dent_reduced_mm.push_back(
+          placed ? 1e3 * near_dent(fr.positions, fr.displacement, *partners[i].field, pose, set.dent_reach) : 0.0);
+      any = any || force > 0;
+    }
+    contact_with.push_back(any);
+    clock.end();
+  };
+  log_info("bench-contact: " + where + ": reduced solver");
+  clock.start();
+  try {
+    run_scene(session, ro);
+  } catch (const SimulationStopped& e) {
+    fail("reduced solver: ", e.what());
+  }
+  return t;
+}
+
+/// The step times of the scene without the compared objects and tools.
+std::vector<double> step_times_without(const SceneDescription& sc, const std::vector<Partner>& partners,
+                                       const SceneContactBenchSettings& set, const SceneContactBenchResult& res) {
+  std::vector<double> ms_without;
+  SceneSessionOptions so;
+  so.progress = set.progress;
+  SceneSession session(without_partners(sc, partners), so);
+  SceneRunOptions ro;
+  ro.progress = set.progress;
+  ro.keep_frames = false;
+  StepClock clock(set.cpu_time);
+  ro.on_step = [&](const Simulator&, const StepReport&) {
+    ms_without.push_back(clock.lap());
+    clock.end();
+  };
+  log_info("bench-contact: " + res.scene + ": reduced solver without " + res.removed);
+  clock.start();
+  run_scene(session, ro);
+  return ms_without;
+}
+
 }  // namespace
 
 void check_scene_contact_bench(const SceneDescription& sc) {
@@ -181,134 +331,20 @@ SceneContactBenchResult run_scene_contact_bench(const SceneDescription& scene, c
     res.removed += (res.removed.empty() ? "" : ", ") + p.name;
   }
   const size_t np = partners.size();
-  size_t n_obstacles = 0;  // the partners with a shape come first (contact_partners)
-  for (const Partner& p : partners) n_obstacles += p.grasp_tool < 0;
+  const ReferenceTrace full = run_reference(sc, partners, set, res);
+  const std::vector<double>& ms_full = full.ms;
+  const std::vector<bool>& contact_full = full.contact;
+  const std::vector<std::vector<Vec3>>&force_full = full.force, &position = full.position;
 
-  // The full-FEM reference: forces, dents and obstacle positions per step.
-  std::vector<double> ms_full;
-  std::vector<bool> contact_full;
-  std::vector<std::vector<Vec3>> force_full(np), position(np);
-  {
-    SceneReferenceOptions ro;
-    ro.progress = set.progress;
-    ro.on_step = [&](const SceneReferenceStep& s) {
-      const FullFemReport& rep = *s.report;
-      require(rep.contacts.size() == n_obstacles, where, ": the full-FEM reference has ", rep.contacts.size(),
-              " obstacles, expected ", n_obstacles);
-      require(s.fem->displacement().allFinite(), where, ": the full-FEM reference became non-finite at step ", s.step,
-              " (t = ", s.time, " s)");
-      const Points x = s.fem->posed_surface(), u = s.fem->soft_displacement();
-      bool any = false;
-      for (size_t i = 0; i < np; ++i) {
-        const int tool = partners[i].grasp_tool;
-        const Vec3 f = tool < 0 ? rep.contacts[i].force : s.tool_forces->at(size_t(tool));
-        const Isometry& pose = tool < 0 ? s.obstacle_poses->at(i) : s.tool_poses->at(size_t(tool));
-        require(f.allFinite(), where, ": the full-FEM ", tool < 0 ? "contact" : "grasp", " force of '", partners[i].name,
-                "' became non-finite at step ", s.step, " (t = ", s.time, " s)");
-        force_full[i].push_back(f);
-        position[i].push_back(pose.translation());
-        res.pairs[i].force_full_n.push_back(f.norm());
-        res.pairs[i].dent_full_mm.push_back(1e3 * near_dent(x, u, *partners[i].field, pose, set.dent_reach));
-        any = any || f.norm() > 0;
-      }
-      res.time.push_back(s.time);
-      ms_full.push_back(set.cpu_time ? s.cpu_ms : rep.ms_total);
-      contact_full.push_back(any);
-    };
-    log_info("bench-contact: " + where + ": full-FEM reference");
-    run_scene_reference(sc, ro);
-  }
   bool touched = false;
   for (bool c : contact_full) touched = touched || c;
   require(touched, where, ": the full-FEM reference has no contact between body '", res.body, "' and ", res.removed,
           " in ", contact_full.size(), " steps; nothing to compare");
 
-  // The reduced solver as `sflsh simulate` runs the scene.
-  std::vector<double> ms_with;
-  std::vector<bool> contact_with;
-  {
-    SceneSessionOptions so;
-    so.progress = set.progress;
-    so.inject_nan_at_step = set.inject_nan_at_step;
-    SceneSession session(sc, so);
-    const SimulationResult header = session.result_header();
-    std::vector<int> object_index(np, -1);
-    for (size_t i = 0; i < np; ++i)
-      for (size_t j = 0; j < header.objects.size(); ++j)
-        if (header.objects[j].name == partners[i].name) object_index[i] = int(j);
-    const int body = session.body_model_index(0);
-    for (const Partner& p : partners)
-      require(p.grasp_tool < 0 || session.tool_index(p.name) == p.grasp_tool, where, ": tools '", p.name,
-              "' is not the scene's tool ", p.grasp_tool);
-    SceneRunOptions ro;
-    ro.progress = set.progress;
-    ro.keep_frames = false;
-    StepClock clock(set.cpu_time);
-    ro.on_step = [&](const Simulator&, const StepReport& rep) {
-      ms_with.push_back(clock.lap());
-      const FrameData fr = session.frame(0.0);  // skin with the patches' dents; one body: its rows
-      const std::vector<Isometry> poses = session.object_poses();
-      bool any = false;
-      for (size_t i = 0; i < np; ++i) {
-        const std::string term = "contact:" + partners[i].name;
-        double force = 0;
-        int nodes = 0;
-        const int tool = partners[i].grasp_tool;
-        for (const TermQuantityReport& q : rep.quantities) {
-          if (q.body != body) continue;
-          if (tool >= 0) {  // a grasping tool's patch: its anchor terms'
-            const std::vector<int>& at = session.compiled_tool(tool).anchor_terms;
-            if (q.name == "patch_nodes" && q.value.size() == 1 && std::count(at.begin(), at.end(), q.term_index))
-              nodes = std::max(nodes, int(q.value[0]));
-            continue;
-          }
-          if (q.term != term) continue;
-          if (q.name == "force" && q.value.size() == 3) force = Vec3(q.value[0], q.value[1], q.value[2]).norm();
-          if (q.name == "patch_nodes" && q.value.size() == 1) nodes = int(q.value[0]);
-        }
-        if (tool >= 0) force = session.tool_state(tool).force.norm();  // on the tool: its anchors
-        require(std::isfinite(force), where, ": the reduced ", tool < 0 ? "contact" : "grasp", " force of '",
-                partners[i].name, "' became non-finite at step ", ms_with.size());
-        SceneContactPair& p = res.pairs[i];
-        p.force_reduced_n.push_back(force);
-        p.patch_nodes.push_back(nodes);
-        const bool placed = tool >= 0 || object_index[i] >= 0;
-        const Isometry pose = tool >= 0 ? session.tool_state(tool).pose
-                                        : object_index[i] >= 0 ? poses.at(size_t(object_index[i])) : Isometry::Identity();
-        p.dent_reduced_mm.push_back(
-            placed ? 1e3 * near_dent(fr.positions, fr.displacement, *partners[i].field, pose, set.dent_reach) : 0.0);
-        any = any || force > 0;
-      }
-      contact_with.push_back(any);
-      clock.end();
-    };
-    log_info("bench-contact: " + where + ": reduced solver");
-    clock.start();
-    try {
-      run_scene(session, ro);
-    } catch (const SimulationStopped& e) {
-      fail("reduced solver: ", e.what());
-    }
-  }
-
-  // The same scene without the compared objects and tools: its step times.
-  std::vector<double> ms_without;
-  {
-    SceneSessionOptions so;
-    so.progress = set.progress;
-    SceneSession session(without_partners(sc, partners), so);
-    SceneRunOptions ro;
-    ro.progress = set.progress;
-    ro.keep_frames = false;
-    StepClock clock(set.cpu_time);
-    ro.on_step = [&](const Simulator&, const StepReport&) {
-      ms_without.push_back(clock.lap());
-      clock.end();
-    };
-    log_info("bench-contact: " + where + ": reduced solver without " + res.removed);
-    clock.start();
-    run_scene(session, ro);
-  }
+  const ReducedTrace reduced = run_reduced(sc, partners, set, res);
+  const std::vector<double>& ms_with = reduced.ms;
+  const std::vector<bool>& contact_with = reduced.contact;
+  const std::vector<double> ms_without = step_times_without(sc, partners, set, res);
   require(ms_with.size() == contact_full.size() && ms_without.size() == ms_with.size(), where,
           ": the runs took different step counts (full FEM ", contact_full.size(), ", reduced ", ms_with.size(),
           ", without contact ", ms_without.size(), ")");
