@@ -201,7 +201,6 @@ PatchPattern& PatchPattern::operator=(const PatchPattern& other) {
 long PatchPattern::analyses() const { return impl_ ? impl_->analyses : 0; }
 
 struct PatchCholesky::Impl {
-  long n = 0;
   bool ok = false;
   long stamp = -1;  // the stamp of the pattern this factor's structure is a copy of
   // The structure the factor was made on (a copy: the shared pattern may widen later).
@@ -215,7 +214,6 @@ struct PatchCholesky::Impl {
 
   void sync(const PatchPattern::Impl& p) {
     if (stamp == p.stamp) return;
-    n = p.n;
     to = p.to;
     col_first = p.col_first;
     col_row = p.col_row;
@@ -273,7 +271,7 @@ bool PatchCholesky::factor(PatchPattern& pattern, const MatX& A, const MatX* B, 
   if (!impl_) impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   PatchPattern::Impl& p = *pattern.impl_;
-  if (!p.analyzed || A.rows() != p.n) p.analyzed = false, p.analyze(A, B);
+  if (!p.analyzed || A.rows() != p.n) p.analyze(A, B);  // a new size starts over (analyze widens only at its size)
   m.sync(p);
   if (!p.fill(A, B, sign, shift, m.L)) {  // outside the analysed pattern: widen it
     p.analyze(A, B);
@@ -290,7 +288,7 @@ bool PatchCholesky::factor(const MatX& A, const MatX* B, double sign, double shi
 }
 
 bool PatchCholesky::ok() const { return impl_ && impl_->ok; }
-long PatchCholesky::rows() const { return ok() ? impl_->n : 0; }
+long PatchCholesky::rows() const { return ok() ? 3 * long(impl_->nodes()) : 0; }
 
 VecX PatchCholesky::solve(const VecX& b) const {  // A⁻¹ = Pᵀ L⁻ᵀ L⁻¹ P
   const Impl& m = *impl_;

@@ -333,7 +333,6 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   std::vector<Vec3> gv(p_derivatives ? nv : 0, Vec3::Zero());
   std::unordered_map<long, Mat3> Mvw;  // with Φ_pp (EvaluationMode::pp_hessian)
   std::vector<char> touched(nv, 0);     // a vertex of a touching sample's face
-  bool touching_any = false;
   for (size_t fi = 0; fi < c.faces.size(); ++fi) {
     const int fc = c.faces[fi];
     std::array<int, 3> vs;
@@ -381,7 +380,6 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
     }
     if (!touching) continue;
-    touching_any = true;
     for (int i = 0; i < 3; ++i) {
       touched[vs[i]] = 1;
       gv[vs[i]] += g[i];
@@ -390,7 +388,7 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
           Mvw.try_emplace(long(vs[i]) * long(nv) + vs[j], Mat3::Zero()).first->second += M[i][j];
     }
   }
-  if (!p_derivatives || !touching_any) return E;
+  if (!p_derivatives || std::find(touched.begin(), touched.end(), 1) == touched.end()) return E;
   // Patch DoFs: ∂x_v/∂δu_c = b_vc A_v.
   for (size_t v = 0; v < nv; ++v)
     for (const auto& [pi, bi] : couple[v])

@@ -56,8 +56,8 @@
 // Then ∂E/∂q = ∂Φ/∂q at the minimizer (envelope theorem) and the Hessian is
 // the Schur complement Φ_qq − Φ_qp Φ_pp⁻¹ Φ_pq over the rows the patch
 // touches, so the global step stays one Newton step over bones and handles.
-// Approximations, all in the Hessian only: Gauss–Newton for the contact, the element Hessians PSD-projected, the
-// change of the elastic Hessian in the patch (K(Wz + δu) − K^sub(Wz)) reduced
+// Approximations, all in the Hessian only: Gauss–Newton for the contact, the
+// element Hessians PSD-projected, the change of the elastic Hessian in the patch (K(Wz + δu) − K^sub(Wz)) reduced
 // to its small-strain part (the bulk share mean dilatation leaves out, rank
 // one per tet), the cross block Φ_zp taken at the subspace's state (Wᵀ K^sub)
 // with a guard that keeps the complement below what the subspace holds
