@@ -34,9 +34,6 @@ ContactDescription parse_contact(const SceneParser& p, const YAML::Node& n, cons
       if (const auto r = v["pressure_stiffness"]) c.pressure_stiffness = p.positive(r, pk + ".pressure_stiffness");
       if (const auto r = v["spacing"]) c.patch_spacing = p.positive(r, pk + ".spacing");
     }
-    if (c.patch && c.friction > 0)
-      p.error(v, pk, "the contact patch is frictionless; set contact.friction: 0 to use it (friction is ", c.friction,
-              ")");
   }
   if (const auto v = n["bodies"]) {
     const std::string bk = "contact.bodies";

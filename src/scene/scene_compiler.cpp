@@ -129,6 +129,7 @@ ContactPatchOptions patch_options(const ContactDescription& c) {
   po.spacing = c.patch_spacing;
   po.patch_radius = c.patch_radius;
   po.max_patch_nodes = c.max_patch_nodes;
+  po.friction = c.friction;
   return po;
 }
 

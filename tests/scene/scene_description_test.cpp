@@ -605,7 +605,12 @@ TEST(SceneDescription, ContactPatchKeysParseWriteBackAndRefuseBadValues) {
   EXPECT_EQ(again.contact.pressure_stiffness, 5.0e7);
   EXPECT_EQ(again.contact.patch_spacing, 0.003);
   EXPECT_TRUE(parse_scene_description(body + "contact: {friction: 0, patch: true}\n", folder.file("t.yaml")).contact.patch);
-  expect_scene_error(body + "contact: {patch: true}\n", {"scene.yaml:5:", "contact.patch", "frictionless", "friction: 0"});
+  {
+    // The patch takes the scene's friction (default 0.5).
+    const SceneDescription with_friction = parse_scene_description(body + "contact: {patch: true}\n", folder.file("f.yaml"));
+    EXPECT_TRUE(with_friction.contact.patch);
+    EXPECT_EQ(with_friction.contact.friction, 0.5);
+  }
   expect_scene_error(body + "contact: {friction: 0, patch: {radius: 0}}\n", {"scene.yaml:5:", "contact.patch.radius"});
   expect_scene_error(body + "contact: {friction: 0, patch: {max_nodes: 0}}\n", {"scene.yaml:5:", "contact.patch.max_nodes"});
   expect_scene_error(body + "contact: {friction: 0, patch: {max_nodes: 2.5}}\n",

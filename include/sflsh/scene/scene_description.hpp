@@ -40,11 +40,11 @@
 //     friction: 0.5             # Coulomb μ between skin and rigid objects (>= 0); default 0.5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
-//     patch:                    # contact that dents (rigid objects, kinematic tools; needs
-//                               # friction: 0): a pressure over the skin's faces and a full-space
-//                               # patch under it (sim/energies/contact_patch.hpp), also under a
-//                               # kinematic tool's grasp anchors; `patch: true` takes the
-//                               # defaults; default off
+//     patch:                    # contact that dents (rigid objects, kinematic tools): a
+//                               # pressure over the skin's faces with `friction`, and a full-space
+//                               # patch under it (sim/energies/contact_patch.hpp), also under
+//                               # tools' grasp anchors; `patch: true` takes the defaults;
+//                               # default off
 //       radius: 0.04            # m: nodes within it of the near skin; grows to 1.5 contact radii
 //       max_nodes: 120          # nodes in one patch at most (>= 1)
 //       pressure_stiffness: 1.0e8   # N/m³ (> 0)
@@ -299,12 +299,12 @@ struct ContactDescription {
   /// contact.patch: body–object contact sampled over the skin's faces with a
   /// pressure stiffness, and a full-space patch under it
   /// (sim/energies/contact_patch.hpp), for static, kinematic and dynamic
-  /// objects (a dynamic one's 6 DoFs join the condensed system).
-  /// Frictionless: refused with friction > 0 (an object resting on a slope
-  /// slides). Kinematic tools (and their jaws) get it too,
-  /// their grasp anchors in the patch of the tool's shape (or a patch of
-  /// their own: PatchAnchors); coupled tools keep the per-sample penalty and
-  /// anchors on the subspace.
+  /// objects (a dynamic one's 6 DoFs join the condensed system), with
+  /// `friction` lagged per step over the face samples. Kinematic tools (and
+  /// their jaws) get it too, their grasp anchors in the patch of the tool's
+  /// shape (or a patch of their own: PatchAnchors); coupled tools keep the
+  /// per-sample penalty for their shape and jaws, and their anchors get a
+  /// patch of their own.
   bool patch = false;
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
   int max_patch_nodes = ContactPatchOptions().max_patch_nodes;

@@ -53,6 +53,9 @@ ContactPatchTerm::ContactPatchTerm(std::string object, const Avatar& a, geometry
           ": inner iterations must be >= 1 and the tolerances >= 0");
   require(std::isfinite(o.release_time) && o.release_time > 0, what, ": release_time ", o.release_time,
           " s, expected a finite number > 0");
+  require(std::isfinite(o.friction) && o.friction >= 0, what, ": friction ", o.friction, ", expected >= 0");
+  require(std::isfinite(o.static_slip_speed) && o.static_slip_speed > 0, what, ": static slip speed ",
+          o.static_slip_speed, " m/s, expected > 0");
   require(o.max_patch_nodes >= 1, what, ": max_patch_nodes ", o.max_patch_nodes, ", expected >= 1");
   require(std::isfinite(o.patch_radius_per_contact_radius) && o.patch_radius_per_contact_radius >= 0, what,
           ": patch_radius_per_contact_radius ", o.patch_radius_per_contact_radius, ", expected a finite number >= 0");
@@ -382,6 +385,7 @@ void ContactPatchTerm::begin_step(const StepContext& ctx) const {
     c.du.segment<3>(3 * i) = h->second.du;
     c.du_predicted.segment<3>(3 * i) = 2 * h->second.du - h->second.du_prev + h->second.du_back;
   }
+  prepare_friction(ctx, c, qt);
   if (c.releasing) c.du *= decay;
   c.samples_in_patch.clear();
   c.sample_x_star.clear();

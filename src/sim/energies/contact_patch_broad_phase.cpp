@@ -1,5 +1,6 @@
 // The patch term's broad phase (contact_patch.hpp, "Life of a patch"): the
-// skin vertices near the object at time t, and the candidate faces around them.
+// skin vertices near the object at time t, the candidate faces around them,
+// and their samples' friction at t ("Friction").
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -12,6 +13,7 @@
 namespace sflsh {
 
 using contact_patch_detail::PatchCache;
+using contact_patch_detail::patched_vertex;
 
 /// The skin vertices near the object at time t (by increasing index) and
 /// their φ; also places the field at t + h (cache's field_pose).
@@ -99,6 +101,45 @@ void ContactPatchTerm::collect_candidate_faces(TermCache& cache, const std::vect
     for (int i = 0; i < 3; ++i) {
       const int v = a.surface_faces(fc, i);
       if (c.vertex_slot.emplace(v, int(c.vertices.size())).second) c.vertices.push_back(v);
+    }
+  }
+}
+
+void ContactPatchTerm::prepare_friction(const StepContext& ctx, TermCache& cache, const Configuration& qt) const {
+  PatchCache& c = static_cast<PatchCache&>(cache);
+  const size_t ns = c.samples.size();
+  c.friction_bound.assign(ns, 0.0);
+  c.friction_normal.assign(ns, Vec3::Zero());
+  c.friction_point.assign(ns, Vec3::Zero());
+  c.face_friction.assign(c.faces.size(), 0);
+  if (!(options_.friction > 0) || !field_ || ns == 0) return;
+  // The field where the broad phase placed it (a kinematic object's pose at
+  // t + h, a dynamic one's at t, as sdf_contact.cpp) and, for a kinematic
+  // object, its motion over the step.
+  const Isometry& T = c.field_pose;
+  const Isometry T_inv = T.inverse();
+  Vec3 v = Vec3::Zero(), w = Vec3::Zero(), origin = T.translation();
+  if (dynamic_) {
+    c.object_t = ctx.bound[1].q_prev->bones[0];
+  } else {
+    const WorldFrame& f = *ctx.frame();
+    v = f.linear_velocity, w = f.angular_velocity;
+    origin = f.pose.translation() - v * ctx.h;  // the frame's origin at t
+  }
+  std::vector<Vec3> xv(c.vertices.size());
+  for (size_t i = 0; i < xv.size(); ++i) xv[i] = patched_vertex(*avatar_, vertices_, c, c.vertices[i], qt, c.du).x;
+  for (size_t fi = 0; fi < c.faces.size(); ++fi) {
+    std::array<int, 3> vs;
+    for (int i = 0; i < 3; ++i) vs[i] = c.vertex_slot.at(avatar_->surface_faces(c.faces[fi], i));
+    for (int s = c.face_first[fi]; s < c.face_first[fi + 1]; ++s) {
+      const SkinFaceSample& smp = c.samples[size_t(s)];
+      const Vec3 x = smp.lambda[0] * xv[size_t(vs[0])] + smp.lambda[1] * xv[size_t(vs[1])] + smp.lambda[2] * xv[size_t(vs[2])];
+      const geometry::SdfSample sd = field_->evaluate(T_inv * x);
+      if (!(sd.distance < 0)) continue;
+      c.friction_bound[size_t(s)] = options_.friction * options_.pressure_stiffness * smp.area * -sd.distance;
+      c.friction_normal[size_t(s)] = (T.linear() * sd.gradient).normalized();
+      c.friction_point[size_t(s)] = dynamic_ ? x : Vec3(x + ctx.h * (v + w.cross(x - origin)));
+      c.face_friction[fi] = 1;
     }
   }
 }

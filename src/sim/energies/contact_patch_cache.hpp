@@ -24,7 +24,8 @@ struct ContactPatchTerm::Evaluation {
   MatX Hqq;  // Φ_qq: contact (Gauss–Newton), the nodes' inertia less the samples', the bulk share
   MatX Hqp;  // cross block (layout rows by patch DoFs)
   MatX Hzp_stiffening;  // what the dented tets' stiffness adds to Hqp's z rows: Wᵀ (K1 − K0), by patch DoFs
-  Vec3 force = Vec3::Zero();
+  Vec3 force = Vec3::Zero();           // N, on the body: pressure and friction
+  Vec3 friction_force = Vec3::Zero();  // N, its friction part
   Vec3 point_sum = Vec3::Zero();  // Σ |f_s| x_s over the touching samples (world, m·N)
   double point_weight = 0;        // Σ |f_s|
   int active = 0;
@@ -71,6 +72,14 @@ struct PatchCache : TermCache {
   std::vector<int> faces;                      // candidate skin faces
   std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
   std::vector<int> face_first;                 // samples of faces[i]: [face_first[i], face_first[i+1])
+  // Friction at time t (contact_patch.hpp, "Friction"), per sample of `samples`:
+  // μ λ_s (N; 0: no friction), the normal n_s, and the touched point: where a
+  // kinematic object carries it by t + h, a dynamic one's at t (carried by
+  // G(q) G_t⁻¹, object_t = G_t); per face, whether a sample has friction.
+  std::vector<double> friction_bound;
+  std::vector<Vec3> friction_normal, friction_point;
+  std::vector<char> face_friction;
+  Isometry object_t = Isometry::Identity();
   std::vector<int> vertices;                   // distinct vertices of the candidate faces
   std::unordered_map<int, int> vertex_slot;    // vertex → index into `vertices`
   double radius = 0;                           // this step's patch radius (m, ContactPatchOptions)

@@ -12,6 +12,7 @@
 #include "sflsh/sim/linearized_stiffness.hpp"
 #include "sflsh/sim/point_hessian.hpp"
 #include "sim/energies/contact_patch_cache.hpp"
+#include "sim/energies/lagged_friction.hpp"
 
 namespace sflsh {
 
@@ -318,6 +319,9 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   using Mat63 = Eigen::Matrix<double, 6, 3>;
   std::vector<Mat63> Nv(ob >= 0 && q_hessian ? c.vertices.size() : 0, Mat63::Zero());
   const double kappa = options_.pressure_stiffness;
+  const double eps = options_.static_slip_speed * ctx.h;  // friction's slip scale
+  // A dynamic object carries the point it touched at t by G(q) G_t⁻¹.
+  const Isometry carry = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * c.object_t.inverse()) : Isometry::Identity();
   const size_t nv = c.vertices.size();
   std::vector<Vec3> xv(nv);
   std::vector<Mat3> Av(nv);
@@ -343,7 +347,8 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
     const Vec3 centre = (xv[vs[0]] + xv[vs[1]] + xv[vs[2]]) / 3.0;
     const double radius = std::sqrt(std::max({(xv[vs[0]] - centre).squaredNorm(), (xv[vs[1]] - centre).squaredNorm(),
                                               (xv[vs[2]] - centre).squaredNorm()}));
-    if (field_->distance(T_inv * centre) > 2.0 * radius + 1e-3) continue;
+    const bool friction = !c.face_friction.empty() && c.face_friction[fi];
+    if (!friction && field_->distance(T_inv * centre) > 2.0 * radius + 1e-3) continue;
     std::array<Vec3, 3> g{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
     std::array<std::array<Mat3, 3>, 3> M;
     for (auto& row : M) row.fill(Mat3::Zero());
@@ -351,6 +356,32 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
     for (int s = c.face_first[fi]; s < c.face_first[fi + 1]; ++s) {
       const SkinFaceSample& smp = c.samples[s];
       const Vec3 x = smp.lambda[0] * xv[vs[0]] + smp.lambda[1] * xv[vs[1]] + smp.lambda[2] * xv[vs[2]];
+      if (friction && c.friction_bound[s] > 0) {
+        // Friction against the point the object carries (header comment, "Friction").
+        const Vec3 y = dynamic_ ? Vec3(carry * c.friction_point[s]) : c.friction_point[s];
+        const contact_friction::PointFriction f =
+            contact_friction::point_friction(x, y, c.friction_normal[s], c.friction_bound[s], eps, true);
+        E += f.energy;
+        out.force -= f.gradient;
+        out.friction_force -= f.gradient;
+        if (p_derivatives) {
+          touching = true;
+          for (int i = 0; i < 3; ++i) {
+            g[i] += smp.lambda[i] * f.gradient;
+            if (out.has_Hpp)
+              for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * f.hessian;
+          }
+          if (ob >= 0 && q_derivatives) {
+            Mat63 JoT;  // J_oᵀ at the object's point y
+            JoT << hat(y), Mat3::Identity();
+            out.gq.segment<6>(ob) -= JoT * f.gradient;
+            if (q_hessian) {
+              out.Hqq.block<6, 6>(ob, ob) += JoT * f.hessian * JoT.transpose();
+              for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * f.hessian);
+            }
+          }
+        }
+      }
       const geometry::SdfSample sd = field_->evaluate(T_inv * x);
       if (!(sd.distance < 0)) continue;
       touching = p_derivatives;

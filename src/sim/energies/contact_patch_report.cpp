@@ -44,6 +44,7 @@ std::vector<TermQuantity> ContactPatchTerm::report(const StepContext& ctx, const
     for (size_t i = 0; i < c.nodes.size(); ++i) c.history[c.nodes[i]].du_back_next = back.segment<3>(3 * long(i));
   }
   std::vector<TermQuantity> out = {{"force", "N", ev.force},
+          {"friction_force", "N", ev.friction_force},
           {"active_samples", "", VecX::Constant(1, ev.active)},
           {"max_penetration", "m", VecX::Constant(1, ev.depth)},
           {"contact_area", "m^2", VecX::Constant(1, ev.area)},

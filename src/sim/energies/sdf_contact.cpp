@@ -8,6 +8,7 @@
 
 #include "sflsh/core/error.hpp"
 #include "sflsh/core/rotation.hpp"
+#include "sim/energies/lagged_friction.hpp"
 
 namespace sflsh {
 namespace {
@@ -22,17 +23,6 @@ struct ContactCache : TermCache {
   Isometry object_t = Isometry::Identity();    // dynamic: the object's body pose at t
   Isometry shape_in_frame = Isometry::Identity();  // dynamic: this step's shape-in-body transform
 };
-
-/// IPC's friction mollifier: f1 = f0′ and f1′ at slip z ≥ 0 (ε > 0).
-void mollifier(double z, double eps, double& f0, double& f1, double& df1) {
-  if (z >= eps) {
-    f0 = z, f1 = 1, df1 = 0;
-  } else {
-    f0 = z * z / eps - z * z * z / (3 * eps * eps) + eps / 3;
-    f1 = 2 * z / eps - z * z / (eps * eps);
-    df1 = 2 / eps - 2 * z / (eps * eps);
-  }
-}
 
 ContactCache& contact_cache(const StepContext& ctx, const std::string& name) {
   require(ctx.cache != nullptr, name, ": no cache (call begin_step through begin_term_step or the integrator)");
@@ -266,21 +256,11 @@ void SdfContactTerm::add_point_derivatives(const Configuration& q, const DofLayo
 
 double SdfContactTerm::friction(const StepContext& ctx, const Configuration& q, int p, const Vec3& x, double lambda,
                                 const Vec3& n, const Vec3& y, double mu, double eps, VecRef* grad, MatRef* hess) const {
-  const Mat3 P = Mat3::Identity() - n * n.transpose();
-  const Vec3 s = P * (x - y);
-  const double z = s.norm();
-  double f0, f1, df1;
-  mollifier(z, eps, f0, f1, df1);
-  const double c = mu * lambda;
-  if (!grad && !hess) return c * f0;
-  // ∂D/∂s and ∂²D/∂s² (header comment), pulled back through P.
-  const Vec3 g = z > 0 ? Vec3(c * f1 / z * s) : Vec3::Zero();
-  Mat3 Hs = (2 / eps) * Mat3::Identity();
-  if (z > 0) Hs = (f1 / z) * Mat3::Identity() + (df1 - f1 / z) / (z * z) * s * s.transpose();
-  Hs *= c;
+  const contact_friction::PointFriction f = contact_friction::point_friction(x, y, n, mu * lambda, eps, grad || hess);
+  if (!grad && !hess) return f.energy;
   const DofLayout& L = ctx.bound.empty() ? ctx.layout : ctx.bound[0].layout;
-  add_point_derivatives(q, L, p, g, P * Hs * P, dynamic_ ? ctx.bound[1].layout.base : -1, y, grad, hess);
-  return c * f0;
+  add_point_derivatives(q, L, p, f.gradient, f.hessian, dynamic_ ? ctx.bound[1].layout.base : -1, y, grad, hess);
+  return f.energy;
 }
 
 std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const Configuration& q) const {
@@ -299,11 +279,9 @@ std::vector<TermQuantity> SdfContactTerm::report(const StepContext& ctx, const C
     for (size_t i = 0; i < cand.size(); ++i) {
       if (!(cc.lambda[i] > 0)) continue;
       const Vec3 y = dynamic_ ? Vec3(carry * cc.x_t[i]) : cc.carried[i];
-      const Vec3& n = cc.normal[i];
-      const Vec3 s = (Mat3::Identity() - n * n.transpose()) * (samples_.world_point(cand[i], q) - y);
-      double f0, f1, df1;
-      mollifier(s.norm(), eps, f0, f1, df1);
-      if (s.norm() > 0) friction_force -= options_.friction * cc.lambda[i] * f1 * s.normalized();
+      friction_force -= contact_friction::point_friction(samples_.world_point(cand[i], q), y, cc.normal[i],
+                                                         options_.friction * cc.lambda[i], eps, true)
+                            .gradient;
     }
   }
   force += friction_force;

@@ -109,6 +109,15 @@
 // The decay releases it over a few time constants without a pop, and the
 // term costs one evaluation (no inner Newton, no Schur complement) meanwhile.
 //
+// Friction (Coulomb, lagged per step; Li et al. 2020, "Incremental Potential
+// Contact" §5, as sdf_contact.hpp): a face sample touching at time t, at
+// x_s(t) with the patch's δu(t), gets λ_s = κ a_s max(0, −φ(x_s(t))) and the
+// normal n_s there, and Φ gains μ λ_s f0(|(I − n_s n_sᵀ)(x_s − y_s)|), y_s
+// where the object carries the touched point by the iterate; its gradient and
+// PSD Hessian enter like the pressure's, through the face's vertices (both
+// δu and q), so the patch dents and shears under a dragged or resting object.
+// A sample feels friction one step after it touches.
+//
 // Objects: static, kinematic (a world frame of the step inputs) or
 // dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
 //
@@ -172,6 +181,10 @@ struct ContactPatchOptions {
   /// s (> 0): out of contact, δu decays with this time constant (header comment, "Life of a patch").
   double release_time = 0.02;
   int max_handles = 8;                 ///< basis row truncation of the skin vertices (sdf_contact.hpp)
+  /// Coulomb μ (>= 0) between the skin and the object, lagged per step over
+  /// the face samples as sdf_contact.hpp's friction (header comment, "Friction").
+  double friction = 0.0;
+  double static_slip_speed = 1e-3;  ///< m/s: slip below which friction is a spring (ε = this·h)
   /// The body's elastic term averages the volume change per cell
   /// (SoftTissueOptions::mean_dilatation): the patch subtracts what that term
   /// holds of each tet, so it must know (header comment, "What the patch subtracts").
@@ -220,7 +233,8 @@ class ContactPatchTerm : public EnergyTerm {
   void begin_step(const StepContext& ctx) const override;
   bool active(const StepContext& ctx) const override;
   double compute(const StepContext& ctx, const Configuration& q, VecRef* grad, MatRef* hess) const override;
-  /// "force" (3, N, what the object exerts on the body, world), "active_samples",
+  /// "force" (3, N, what the object exerts on the body, world; pressure and
+  /// friction), "friction_force" (3, N, its friction part), "active_samples",
   /// "max_penetration" (m), "contact_area" (m²), "patch_nodes", "patch_radius" (m), "max_patch_displacement" (m),
   /// "patch_displacement" (4 per patch node: the node's index, then its δu, m, unposed),
   /// "contact_point" (3, m: the touching samples' mean weighted by their force; only in contact);
@@ -299,6 +313,8 @@ class ContactPatchTerm : public EnergyTerm {
   void find_near_vertices(const StepContext& ctx, TermCache& cache, std::vector<int>& near,
                           std::vector<double>& near_phi) const;
   void collect_candidate_faces(TermCache& cache, const std::vector<int>& near) const;
+  /// The candidate samples' friction at time t (x_s with the patch's δu(t), cache's du; header comment, "Friction").
+  void prepare_friction(const StepContext& ctx, TermCache& cache, const Configuration& qt) const;
   void prepare_patch_tets(TermCache& cache) const;
   /// det F(W z + δu) of each patch tet (cache order).
   std::vector<double> patch_tet_determinants(const TermCache& cache, const VecX& z, const VecX& du) const;

@@ -96,6 +96,7 @@ class SdfContactTerm : public EnergyTerm {
   std::vector<TermQuantity> report(const StepContext& ctx, const Configuration& q) const override;
 
   const PosedPoints& samples() const { return samples_; }
+  const SdfContactOptions& options() const { return options_; }
   const std::string& object() const { return object_; }
   bool dynamic_object() const { return dynamic_; }
   /// The field's world pose (step frame) for this context: from the frame or the object's iterate.
