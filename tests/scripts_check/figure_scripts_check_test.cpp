@@ -84,7 +84,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         Case{"teleop", "good", 0, {"| 0 (RTF 1.000;", "66.6 J / 64.0 J"}},
         Case{"teleop", "pinch_slips", 1, {"target missed: pinch-and-lift", "2.80 mm"}},
-        Case{"teleop", "pinch_no_return", 1, {"target missed: skin against the same run", "1.20 mm"}},
+        Case{"teleop", "pinch_no_return", 1, {"target missed: skin against the same run", "/ 0.70 / 1.20 mm"}},
+        Case{"teleop", "pinch_ends_early", 2, {"pinch_coupled.h5: the run ends 1.13 s after the release"}},
         Case{"teleop", "pinch_nan", 1, {"target missed: grasp / release", ", NaN (target"}},
         Case{"teleop", "realtime_behind", 1, {"target missed: real time", "frames behind: 3 (RTF 1.000"}},
         Case{"teleop", "yank_energy_grows", 1, {"target missed: abuse: gripper yanked", "84.0 J"}},

@@ -59,27 +59,30 @@ def cycle_energy(t, first_peak, later_peak, period=2.5):
 
 def teleop(variant, d):
     p = lambda n: os.path.join(d, n)  # noqa: E731
-    # Pinch-and-lift, 2.5 s: grasp at 0.3 s, release at 1.5 s; 4 skin vertices, 76 frames.
-    t = np.arange(0, 2.5, 0.01)
+    # Pinch-and-lift, 3.5 s: grasp at 0.3 s, release at 1.5 s; 4 skin vertices, 106 frames.
+    t = np.arange(0, 3.5, 0.01)
     anchors = ((t >= 0.3) & (t < 1.5)) * 12
     stretch = np.where(anchors > 0, 0.0028 if variant == "pinch_slips" else 0.00028, 0.0)
     tool_csv(p("pinch_coupled_tools.csv"), t, 0.5 * (anchors > 0), anchors, stretch)
-    write(p("pinch_coupled.log"), "as fast as possible: simulated 2.500 s in 1.2 s of wall time (1250 steps), RTF 2.083\n"
-          + steps_line(1250) + "tool gripper t = 0.300 s: grasp 12 skin points of alice\n"
+    write(p("pinch_coupled.log"), "as fast as possible: simulated 3.500 s in 1.7 s of wall time (1750 steps), RTF 2.059\n"
+          + steps_line(1750) + "tool gripper t = 0.300 s: grasp 12 skin points of alice\n"
           "tool gripper t = 1.500 s: release 12 skin points of alice\n")
-    frames, verts = 76, 4
+    frames, verts = 106, 4
     u_open = np.zeros((frames, verts, 3))
     u_open[:, :, 1] = 0.002
     u = u_open.copy()
     u[20:45, 0, 2] += 0.0132  # the lift
+    u[75, 0, 2] += 0.0007  # 1 s after the release, still swinging back
     u[-1, 0, 2] += 0.0012 if variant == "pinch_no_return" else 0.0002
+    if variant == "pinch_ends_early":
+        u, u_open = u[:80], u_open[:80]
     positions = np.ones((frames, verts, 3))
     if variant == "pinch_nan":
         positions[40, 2, 0] = np.nan
     with h5py.File(p("pinch_coupled.h5"), "w") as h:
         h["/frames/positions"] = positions
         h["/frames/displacement"] = u
-        h["/frames/time"] = np.arange(frames) / 30.0
+        h["/frames/time"] = np.arange(len(u)) / 30.0
     with h5py.File(p("pinch_open.h5"), "w") as h:
         h["/frames/displacement"] = u_open[:, :3] if variant == "pinch_open_shape" else u_open
 
