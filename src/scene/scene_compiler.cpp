@@ -181,13 +181,12 @@ RigidObjectModel tool_shape(const std::string& name, const ShapeDescription& sha
 }
 
 /// Adds a tool: with `coupling` a rigid body pulled by a virtual coupling;
-/// contact with every body through its shape and jaws (with contact.patch a
-/// kinematic tool gets the face-sampled contact, a coupled one keeps the
-/// per-sample penalty); with sensors one anchor term per body for grasping
-/// (with contact.patch, a kinematic tool's anchors join the patch of the
-/// tool's shape, or get their own: one patch under the tool, whose
-/// displacement the shape and the anchors share; a coupled tool's anchors
-/// get a patch of their own).
+/// contact with every body through its shape and jaws (with contact.patch the
+/// face-sampled contact and its patch, a coupled tool's bound to its body,
+/// the jaws through their moving shape frames); with sensors one anchor term
+/// per body for grasping (with contact.patch, the anchors join the patch of
+/// the tool's shape, or get their own: one patch under the tool, whose
+/// displacement the shape and the anchors share).
 /// Records the tool's input ids and the terms that act on it.
 CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vector<CompiledBody>& bodies,
                       const ContactDescription& c, SkinSamples& samples) {
@@ -219,13 +218,12 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
   if (d.has_shape) t.shape = tool_shape(d.name, d.shape);
   for (const ToolSensorDescription& sd : d.sensors) t.grasp.sensors.push_back({sd.origin, sd.direction, sd.range});
   t.grasp.closure_threshold = d.closure_threshold;
-  const bool patch = c.patch && !coupled;
   for (const CompiledBody& b : bodies) {
     const std::string anchor_set = d.name + "@" + b.desc->name;
     const AnchorOptions anchor_options{d.hardness, d.damping};
     const bool grasps = !d.sensors.empty();
-    // The shape shares the anchors' patch: a kinematic tool's, with contact.patch and a grasp.
-    const bool shape_in_patch = patch && grasps && d.has_shape;
+    // The shape shares the anchors' patch, with contact.patch and a grasp.
+    const bool shape_in_patch = c.patch && grasps && d.has_shape;
     if (c.patch && grasps) {
       // The anchors' patch (a coupled tool's body bound second).
       auto term = std::make_shared<const ContactPatchTerm>(d.name, *b.avatar, shape_in_patch ? t.shape.field : nullptr,
@@ -238,10 +236,10 @@ CompiledTool add_tool(ModelBuilder& mb, const ToolDescription& d, const std::vec
     }
     if (d.has_shape && !shape_in_patch)
       t.contact_terms.push_back(add_shape_contact(mb, b, d.name, t.shape.field, Isometry::Identity(), coupled,
-                                                  t.model_index, patch, c, samples));
+                                                  t.model_index, c.patch, c, samples));
     for (const CompiledJaw& jaw : t.jaws)
       t.contact_terms.push_back(add_shape_contact(mb, b, jaw.name, jaw.model.field, Isometry::Identity(), coupled,
-                                                  t.model_index, patch, c, samples));
+                                                  t.model_index, c.patch, c, samples));
     if (!grasps || c.patch) continue;
     auto term = std::make_shared<const AnchorTerm>(anchor_set, PosedPoints::at_surface(*b.avatar), coupled,
                                                    anchor_options);

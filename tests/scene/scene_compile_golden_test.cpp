@@ -430,14 +430,15 @@ TEST_F(SceneCompileGolden, GripperWithJawsDampingAndStiffnessScale) {
 }
 
 TEST_F(SceneCompileGolden, ContactPatchWithKinematicAndCoupledTools) {
-  // A kinematic probe and a coupled pusher on the box. Re-pinned only with a
-  // change of the patch's physics (git log of this file says which).
+  // A kinematic probe and a coupled pusher on the box, both through the
+  // patch. Re-pinned only with a change of the patch's physics (git log of
+  // this file says which).
   check({kPatchScene, nullptr, 20,
          {"inertia@0; elastic@0; gravity@0; contact:floor@0; contact:probe@0; bone_inertia@1; coupling:pusher@1; contact:pusher@0,1",
           "base:0/24/18@0 pusher:1/1/0@18 dofs 24 blocks 2 groups 1",
           {0.01, 1.169203622808368e-15, 2100, -0.0019200470859660433, 2.3706550458656302e-07, -1.0061396160665481e-16, 2100, 0, 0, 0.19733333333333333, 14, 0, 0, 0.20000000000000015, 14, 0, 0},
-          {0.20000000000000004, 1.169203622808368e-15, 2100, -0.023808077116800774, 0.013139986990306312, -1.0061396160665481e-16, 2100, -0.029702960750352669, 0.0099349519995510244, 0.14713341594372703, 13.999999999999947, 0, 0, 0.14917186128472998, 13.999999999999991, 0, 0},
-          {21.219133415943674, 1.3613419245459504, 9.4563125272696436, 0, 0.21200000000000002, 42.366700123915514, 0}, 0}});
+          {0.20000000000000004, 1.169203622808368e-15, 2100, -0.039681544057268286, 0.0099369686403196836, -1.0061396160665481e-16, 2100, 0.046550599847803797, 0.023660549822650409, 0.14521371363685665, 14, 0, 0, 0.14779006837432918, 13.999999999999998, 0, 0},
+          {21.217213713636855, 14.860586293648732, 7.8042027780012369, 0, 0.21200000000000002, 42.363820570455289, 0}, 0}});
 }
 
 TEST_F(SceneCompileGolden, CoversEveryExampleScene) {

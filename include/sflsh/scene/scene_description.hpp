@@ -40,7 +40,7 @@
 //     friction: 0.5             # Coulomb μ between skin and rigid objects (>= 0); default 0.5
 //     self_contact: false       # default false
 //     sample_spacing: 0         # m between skin samples (>= 0); default 0 = every skin vertex
-//     patch:                    # contact that dents (rigid objects, kinematic tools): a
+//     patch:                    # contact that dents (rigid objects, tools): a
 //                               # pressure over the skin's faces with `friction`, and a full-space
 //                               # patch under it (sim/energies/contact_patch.hpp), also under
 //                               # tools' grasp anchors; `patch: true` takes the defaults;
@@ -300,11 +300,9 @@ struct ContactDescription {
   /// pressure stiffness, and a full-space patch under it
   /// (sim/energies/contact_patch.hpp), for static, kinematic and dynamic
   /// objects (a dynamic one's 6 DoFs join the condensed system), with
-  /// `friction` lagged per step over the face samples. Kinematic tools (and
-  /// their jaws) get it too, their grasp anchors in the patch of the tool's
-  /// shape (or a patch of their own: PatchAnchors); coupled tools keep the
-  /// per-sample penalty for their shape and jaws, and their anchors get a
-  /// patch of their own.
+  /// `friction` lagged per step over the face samples. Tools (and their
+  /// jaws), kinematic or coupled, get it too, their grasp anchors in the patch
+  /// of the tool's shape (or a patch of their own: PatchAnchors).
   bool patch = false;
   double patch_radius = ContactPatchOptions().patch_radius;  ///< m
   int max_patch_nodes = ContactPatchOptions().max_patch_nodes;

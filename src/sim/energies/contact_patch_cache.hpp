@@ -68,7 +68,8 @@ struct PatchCache : TermCache {
   std::vector<double> saved_state() const override;
   void restore_state(const std::vector<double>& values, const std::string& where) override;
   int num_nodes = 0;  // the avatar's tet nodes (a restored node must be one)
-  Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h
+  Isometry field_pose = Isometry::Identity();  // world (step frame) pose of the field at t + h (dynamic: at t)
+  Isometry shape_in_frame = Isometry::Identity();  // dynamic: this step's shape in the object's body frame
   std::vector<int> faces;                      // candidate skin faces
   std::vector<SkinFaceSample> samples;         // their samples, grouped by face in `faces` order
   std::vector<int> face_first;                 // samples of faces[i]: [face_first[i], face_first[i+1])

@@ -312,7 +312,7 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
   const int ob = object_offset(ctx);  // the object's 6 DoFs in the term's system, or −1
   double E = 0;
   // Contact over the candidate faces' samples.
-  const Isometry T = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * shape_in_frame_) : c.field_pose;
+  const Isometry T = dynamic_ ? Isometry(ctx.bound[1].q->bones[0] * c.shape_in_frame) : c.field_pose;
   const Isometry T_inv = T.inverse();
   // A dynamic object: g_o = Σ_s −J_oᵀ g_s, H_oo = Σ_s J_oᵀ H_s J_o, and per vertex
   // N_v = Σ_s −λ_v J_oᵀ H_s, J_o = [−[x_s]×, I] (the object's point at x_s moves by ω × x + v).

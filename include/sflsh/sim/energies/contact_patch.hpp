@@ -119,7 +119,9 @@
 // A sample feels friction one step after it touches.
 //
 // Objects: static, kinematic (a world frame of the step inputs) or
-// dynamic (a rigid body of the model: its 6 DoFs join the condensed system).
+// dynamic (a rigid body of the model: its 6 DoFs join the condensed system),
+// whose shape may move on it (a jaw of a coupled gripper: the frame
+// "<object>/shape" gives its pose for the step, as for sdf_contact.hpp).
 //
 // One patch per term: the patches of two terms (two objects, a gripper's
 // jaws and its anchors) do not merge. Where they overlap, each holds its own
@@ -134,6 +136,7 @@
 
 #include "sflsh/geometry/sdf.hpp"
 #include "sflsh/sim/energies/anchor.hpp"
+#include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/energy_term.hpp"
 #include "sflsh/sim/material.hpp"
 #include "sflsh/sim/posed_points.hpp"
@@ -214,7 +217,8 @@ class ContactPatchTerm : public EnergyTerm {
   /// The object is static or kinematic (a world frame of the step
   /// inputs, placed by `shape_in_frame`), or, when `dynamic_object`, a rigid
   /// body of the model bound second (its configuration's bone 0 times
-  /// `shape_in_frame`; equal and opposite forces, as sdf_contact.hpp).
+  /// `shape_in_frame`, or the step's moving shape frame relative to the body
+  /// at t when the inputs give it; equal and opposite forces, as sdf_contact.hpp).
   /// With `anchors` the term also holds the object's (a tool's) grasping
   /// tool's anchors (PatchAnchors); `field` may then be null (a tool without
   /// a shape: anchors only).
@@ -223,9 +227,12 @@ class ContactPatchTerm : public EnergyTerm {
                    std::optional<PatchAnchors> anchors = std::nullopt);
   /// "contact:<object>", or "anchor:<set>" for anchors without a shape.
   std::string name() const override { return field_ ? "contact:" + object_ : "anchor:" + anchors_->set; }
-  /// Static or kinematic with a shape: the world frame `object`; else none.
+  /// With a shape: the world frame `object` (static or kinematic), or a
+  /// dynamic object's moving shape frame (optional, as SdfContactTerm's: a
+  /// gripper's jaw on a coupled tool); without a shape none.
   std::vector<std::string> input_frames() const override {
-    return dynamic_ || !field_ ? std::vector<std::string>{} : std::vector<std::string>{object_};
+    if (!field_) return {};
+    return {dynamic_ ? moving_shape_frame_name(object_) : object_};
   }
   std::string input_anchor_set() const override { return anchors_ ? anchors_->set : ""; }
   bool in_nonlinearity_check() const override { return false; }  // a contact term (energy_term.hpp)
