@@ -186,7 +186,8 @@ for step in $STEPS; do
       run "$SFLSH" bench-contact --quick --handles 16 --scenes probe --out "$d"
     else
       run "$SFLSH" bench-contact --handles 96 --scenes probe,probe-belly,probe-calf-1cm,pressed,impact --cpu-time \
-        --scene apps/scenes/figures/box_press_belly.yaml --scene apps/scenes/figures/pinch_from_file.yaml --out "$d"
+        --scene apps/scenes/figures/box_press_belly.yaml --scene apps/scenes/figures/pinch_from_file.yaml \
+        --scene apps/scenes/figures/probe_coupled_belly.yaml --out "$d"
     fi
     stamp "$d/contact_bench.md" "$OUT/contact_patch.md"
     stamp "$d/contact_probe.svg" "$OUT/contact_patch_probe.svg" ;;

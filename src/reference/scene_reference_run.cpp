@@ -37,7 +37,6 @@ void check_scene_reference(const SceneDescription& sc) {
     require(o.kind != ObjectKind::Dynamic, where, ": objects '", o.name,
             "' is dynamic; --solver full takes static and kinematic objects only");
   for (const ToolDescription& t : sc.tools) {
-    require(!t.coupled, where, ": tools '", t.name, "' has a coupling; --solver full takes kinematic tools only");
     require(t.stream_port < 0, where, ": tools '", t.name, "' reads a live stream; --solver full runs offline");
     require(t.jaws.empty(), where, ": tools '", t.name, "' has jaws; --solver full has no jaw contact");
   }
@@ -45,8 +44,8 @@ void check_scene_reference(const SceneDescription& sc) {
 
 namespace {
 
-/// The scene as the reference runs it: refusals thrown, dynamic bones made
-/// kinematic and friction dropped (each with a warning).
+/// The scene as the reference runs it: refusals thrown, dynamic bones and
+/// coupled tools made kinematic and friction dropped (each with a warning).
 SceneDescription reference_scene(const SceneDescription& sc) {
   check_scene_reference(sc);
   const std::string& where = scene_name(sc);
@@ -56,6 +55,12 @@ SceneDescription reference_scene(const SceneDescription& sc) {
               << "': --solver full prescribes the bones from the motion (bones: dynamic runs as kinematic)\n";
     out.bodies[0].bones_dynamic = false;
   }
+  for (ToolDescription& t : out.tools)
+    if (t.coupled) {
+      std::cerr << "warning: " << where << ": tools '" << t.name
+                << "': --solver full moves the tool along its device's path (the coupling runs as kinematic)\n";
+      t.coupled = false;
+    }
   bool obstacles = !out.objects.empty();
   for (const ToolDescription& t : out.tools) obstacles = obstacles || t.has_shape;
   if (out.contact.friction > 0 && obstacles)

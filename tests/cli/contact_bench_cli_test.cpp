@@ -72,8 +72,8 @@ TEST_F(ContactBenchSceneCli, BadSceneFilesFailWithOneLineNamingThemAndWriteNothi
       {"solver: {dt: -1}\n" + head.substr(head.find("bodies")), "", {"scene.yaml:1", "solver.dt"}},
       {head + "  - {name: other, avatar: box.h5, placement: {offset: [0.2, 0, 0]}}\n", "", {"scene.yaml", "one body"}},
       {head + "tools:\n  - name: probe\n    shape: {type: sphere, radius: 0.005}\n"
-              "    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    coupling: {stiffness: 2000}\n",
-       "", {"scene.yaml", "tools 'probe'", "coupling"}},
+              "    pose_stream: {port: 7001}\n    coupling: {stiffness: 2000}\n",
+       "", {"scene.yaml", "tools 'probe'", "live stream"}},
       {head, "", {"scene.yaml", "touches no object"}},
       {head + "objects:\n  - {name: ball, shape: {type: sphere, radius: 0.01}, position: [0, 0.037, 0]}\n",
        " --handles 32", {"--handles", "built-in scenes"}},

@@ -16,7 +16,8 @@ namespace {
 using SceneReference = test::BoxAvatarScene;
 
 /// A 1 cm ball lowered from 1.5 cm above the top to 5 mm into it by 0.2 s, then held;
-/// `as` is "objects" (a kinematic object) or "tools" (a kinematic tool).
+/// `as` is "objects" (a kinematic object), "tools" (a kinematic tool) or
+/// "coupled" (a tool pulled along that path by a virtual coupling).
 std::string ball_scene(const std::string& as) {
   const std::string ball = as == "objects" ? R"(objects:
   - name: ball
@@ -32,7 +33,7 @@ std::string ball_scene(const std::string& as) {
     keyframes:
       - {time: 0.0, position: [0.0, 0.045, 0.0]}
       - {time: 0.2, position: [0.0, 0.035, 0.0]}
-)";
+)" + std::string(as == "coupled" ? "    coupling: {stiffness: 2000, mass: 0.05}\n" : "");
   return R"(solver: {dt: 1/100, seconds: 0.3, gravity: [0, 0, 0]}
 contact: {friction: 0}
 output: {fps: 20}
@@ -90,11 +91,22 @@ TEST_F(SceneReference, TheFullFemDentsUnderAKinematicBallAndPushesItUp) {
 }
 
 TEST_F(SceneReference, ABallAsAToolGivesTheSameReferenceAsTheSameBallAsAnObject) {
-  // Two paths to the same obstacle pose (object keyframes, tool track): any
-  // mix-up of poses or fields in either one shows.
-  SceneContactStats a, b;
+  // Three paths to the same obstacle pose (object keyframes, tool track, a
+  // coupled tool's device track): any mix-up of poses or fields in one shows.
+  SceneContactStats a, b, c;
   const SimulationResult ra = run_scene_reference(read_scene_description(write_scene(ball_scene("objects"))), quiet(), &a);
   const SimulationResult rb = run_scene_reference(read_scene_description(write_scene(ball_scene("tools"))), quiet(), &b);
+  {
+    // The coupled tool moves along its device's path (the coupling runs as kinematic), with a warning.
+    ::testing::internal::CaptureStderr();
+    const SimulationResult rc =
+        run_scene_reference(read_scene_description(write_scene(ball_scene("coupled"))), quiet(), &c);
+    const std::string warning = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(warning.find("tools 'ball'"), std::string::npos) << warning;
+    EXPECT_NE(warning.find("device's path"), std::string::npos) << warning;
+    EXPECT_EQ(rc.frame_positions.back(), rb.frame_positions.back());
+    EXPECT_EQ(c.pairs.at(0).last_force, b.pairs.at(0).last_force);
+  }
   ASSERT_EQ(ra.num_frames, rb.num_frames);
   EXPECT_EQ(ra.frame_positions.back(), rb.frame_positions.back());
   EXPECT_EQ(a.pairs.at(0).last_force, b.pairs.at(0).last_force);
@@ -168,8 +180,8 @@ TEST_F(SceneReference, ScenesItCannotRunAreRefusedNamingTheItem) {
                  "position: [0, 0.1, 0]}\n",
           {"scene.yaml", "objects 'rock'", "dynamic"});
   refused(head + "tools:\n  - name: probe\n    shape: {type: sphere, radius: 0.005}\n"
-                 "    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    coupling: {stiffness: 2000}\n",
-          {"scene.yaml", "tools 'probe'", "coupling"});
+                 "    pose_stream: {port: 7001}\n    coupling: {stiffness: 2000}\n",
+          {"scene.yaml", "tools 'probe'", "live stream"});
   refused(head + "tools:\n  - name: pincer\n    keyframes: [{time: 0, position: [0, 0.1, 0]}]\n    gripper:\n"
                  "      hinge: {origin: [0, 0.03, 0], axis: [1, 0, 0]}\n      jaws:\n"
                  "        - {shape: {type: capsule, radius: 0.003, length: 0.02}, offset: [0, 0.01, 0.004], side: 1}\n",

@@ -336,6 +336,16 @@ TEST_F(SceneCompileGolden, ProbeBelly) {
           {0, 0, 0, 0, 0, 9.4540000000000006, 0}, 0}});
 }
 
+// The same probe as a coupled tool: it touches at 0.1 s and its device is 2 mm in at step 12.
+TEST_F(SceneCompileGolden, ProbeCoupledBelly) {
+  check({"figures/probe_coupled_belly.yaml", at_belly, 12,
+         {"inertia@0; elastic@0; bone_inertia@1; coupling:probe@1; contact:probe@0,1",
+          "alice:0/24/18@0 probe:1/1/0@18 dofs 24 blocks 2 groups 1",
+          {0.016666666666666666, 693, 2100, 0, 0, 693, 2100, 0, 0, 4.9300279866376213, 14, 0, 0, 4.9320000000000004, 14, 0, 0},
+          {0.19999999999999998, 693, 2100, 0.0023056248042883937, 7.7096932299920229e-06, 693, 2100, 0.0017780485567180648, 4.9974692726636769e-06, 4.9083327337693881, 14.000000000000002, 0, 0, 4.9102667398762598, 14.000000000000002, 0, 0},
+          {9.4541663668846958, 3.2711368588794718, 3.5044178912292088, 0, 2.4540000000000002, 9.4541663668846958, 0}, 0}});
+}
+
 // The box's back face touches the front face at 0.08 s (step 5) and is 6 mm in at step 20:
 // a contact over the whole face, whose patch grows with it.
 TEST_F(SceneCompileGolden, BoxPressBelly) {
@@ -446,5 +456,5 @@ TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
   for (const char* dir : {"apps/scenes", "apps/scenes/figures"})
     for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(test::source_dir()) / dir))
       scenes += e.path().extension() == ".yaml";
-  EXPECT_EQ(scenes, 16) << "a new example scene: add it to SceneCompileGolden";
+  EXPECT_EQ(scenes, 17) << "a new example scene: add it to SceneCompileGolden";
 }

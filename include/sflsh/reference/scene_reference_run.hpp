@@ -15,8 +15,11 @@
 // anchors start unstretched on the reference's skin) and holds it with the
 // same spring–dampers (FullFemAnchor); its force is the anchors' reaction.
 // Refused (one line naming the scene and the item): several bodies, dynamic
-// objects, tools with a coupling, a live stream or jaws. Dynamic bones
-// run kinematic and friction is dropped, each with a warning line on stderr.
+// objects, tools with a live stream or jaws. Dynamic bones run kinematic, a
+// coupled tool moves along its device's path (keyframes or pose file: where
+// the coupling pulls it; the reduced run's tool lags by the coupling's
+// stretch, force / stiffness), and friction is dropped, each with a warning
+// line on stderr.
 // Cost: seconds per step on the default body (a sparse Cholesky of ~30k DoFs
 // per Newton iteration); progress is shown.
 #include <functional>
