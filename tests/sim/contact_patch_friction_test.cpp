@@ -12,11 +12,9 @@
 
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/sim/energies/contact_patch.hpp"
-#include "sflsh/sim/rigid_body_terms.hpp"
-#include "sflsh/sim/simulator.hpp"
-#include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sim/energies/contact_patch_cache.hpp"
 #include "contact_patch_bordered.hpp"
+#include "sim/incline_fixture.hpp"
 #include "sim/two_body_fixture.hpp"
 #include "test_support.hpp"
 
@@ -102,6 +100,17 @@ TEST(ContactPatchFriction, SlidingFrictionIsMuTimesThePressuresForceAndStickingI
   }
 }
 
+/// A 1.2 cm ball's patch on the box's top with friction μ, minimized to round-off.
+ContactPatchOptions ball_options(double mu) {
+  ContactPatchOptions o;
+  o.pressure_stiffness = 2.0e7;
+  o.spacing = 0.003;
+  o.patch_radius = 0.015;
+  o.inner_tolerance = 1e-13;
+  o.friction = mu;
+  return o;
+}
+
 TEST(ContactPatchFriction, CondensedEnergyGradientMatchesFiniteDifferencesWhileSlidingAndSticking) {
   // A 1.2 cm ball 1.5 mm into the box's top with its patch, moving along the
   // skin (sliding, slip ≫ ε) or barely (sticking, slip < ε); the body's
@@ -111,14 +120,8 @@ TEST(ContactPatchFriction, CondensedEnergyGradientMatchesFiniteDifferencesWhileS
     std::map<std::string, WorldFrame> frames;
     frames["ball"].pose.translation() = Vec3(0.004, 0.03 + 0.012 - 0.0015, -0.003);
     frames["ball"].linear_velocity = Vec3(speed, 0, -0.5 * speed);
-    ContactPatchOptions o;
-    o.pressure_stiffness = 2.0e7;
-    o.spacing = 0.003;
-    o.patch_radius = 0.015;
-    o.inner_tolerance = 1e-13;
-    o.friction = 0.6;
     const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), false,
-                                o);
+                                ball_options(0.6));
     for (bool dynamic : {false, true}) {
       SCOPED_TRACE(std::string(dynamic ? "bones dynamic" : "bones kinematic") + ", speed " + std::to_string(speed));
       StepContext ctx = context(a, &frames, dynamic);
@@ -150,49 +153,31 @@ TEST(ContactPatchFriction, ADynamicObjectGetsTheOppositeFrictionAndItsDerivative
   // step: the flesh it touched at t is dragged along (the friction is ahead
   // of the ball's motion on the body, behind it on the ball).
   const Avatar a = box(6, 6, 0.01);
-  ContactPatchOptions o;
-  o.pressure_stiffness = 2.0e7;
-  o.spacing = 0.003;
-  o.patch_radius = 0.015;
-  o.inner_tolerance = 1e-14;
-  o.friction = 0.5;
-  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), true, o);
-  StepContext ctx = context(a, nullptr, true);
-  Configuration ball, ball_prev;
+  const ContactPatchTerm term("ball", a, std::make_shared<geometry::SphereSdf>(0.012), Isometry::Identity(), true,
+                              ball_options(0.5));
+  using test::two_body::Bound;
+  Configuration ball;
   ball.bones = {Isometry::Identity()};
   ball.bones[0].translation() = Vec3(0.004, 0.03 + 0.012 - 0.0015, -0.003);
   ball.z = VecX();
-  ball_prev = ball;
+  Configuration ball_prev = ball;
   ball_prev.bones[0].translation().x() -= 0.0005;
-  DofLayout ball_layout;
-  ball_layout.num_bones = 1;
-  ball_layout.num_reduced = 0;
-  ball_layout.base = ctx.layout.size();
-  Configuration q = ctx.q_prev;
-  for (int i = 0; i < q.z.size(); ++i) q.z[i] = 4e-4 * std::sin(1.3 * i + 0.2);
-  ctx.bound = {{0, 0, &a, ctx.layout, &q, &ctx.q_prev, &ctx.q_prev2},
-               {1, 1, nullptr, ball_layout, &ball, &ball_prev, &ball_prev}};
+  std::vector<Bound> bodies{{&a, test::two_body::body_layout(a, true), {}, {}, {}},
+                            {nullptr, test::two_body::rigid_layout(0), ball, ball_prev, ball_prev}};
+  bodies[1].layout.base = bodies[0].layout.size();
+  bodies[0].q_prev.bones = identity_bones();
+  bodies[0].q_prev.z = VecX::Zero(a.num_reduced());
+  bodies[0].q_prev2 = bodies[0].q_prev;
+  bodies[0].q = bodies[0].q_prev;
+  for (int i = 0; i < a.num_reduced(); ++i) bodies[0].q.z[i] = 4e-4 * std::sin(1.3 * i + 0.2);
+  StepContext ctx = test::two_body::bind_bodies(bodies, nullptr);
   const auto cache = begin_term_step(term, ctx);
   ASSERT_FALSE(term.patch_nodes(ctx).empty());
-  const int n = ctx.layout.size() + 6;
+  const Configuration& q = bodies[0].q;
+  const int n = test::two_body::total_size(bodies);
   VecX g = VecX::Zero(n);
   ASSERT_GT(term.evaluate(ctx, q, &g, nullptr), 0);
-  VecX fd(n);
-  const double eps = 1e-7;
-  for (int i = 0; i < n; ++i) {
-    double Es[2];
-    for (int sgn = 0; sgn < 2; ++sgn) {
-      VecX d = VecX::Zero(n);
-      d[i] = sgn ? -eps : eps;
-      Configuration qi = retract(q, d, ctx.layout), bi = retract(ball, d, ball_layout);
-      ctx.bound[0].q = &qi;
-      ctx.bound[1].q = &bi;
-      Es[sgn] = term.evaluate(ctx, qi, nullptr, nullptr);
-    }
-    fd[i] = (Es[0] - Es[1]) / (2 * eps);
-  }
-  ctx.bound[0].q = &q;
-  ctx.bound[1].q = &ball;
+  const VecX fd = test::two_body::fd_gradient(term, ctx, bodies, 1e-7);
   EXPECT_LT((g - fd).norm(), 1e-5 * fd.norm()) << "|g| " << g.norm() << ", |fd| " << fd.norm();
   // The ball's generalized force along v is the reaction of the whole force
   // on the body (pressure and friction), and the friction drags the flesh
@@ -200,46 +185,20 @@ TEST(ContactPatchFriction, ADynamicObjectGetsTheOppositeFrictionAndItsDerivative
   const auto r = term.report(ctx, q);
   const Vec3 f = quantity3(r, "force"), friction = quantity3(r, "friction_force");
   EXPECT_GT(friction.x(), 0.05 * f.norm()) << friction.transpose();
-  EXPECT_LT((g.segment<3>(ctx.layout.size() + 3) - f).norm(), 1e-6 * f.norm());
+  EXPECT_LT((g.segment<3>(bodies[1].layout.base + 3) - f).norm(), 1e-6 * f.norm());
 }
 
-/// Where a dynamic slab resting on the box's top ends after 1 s with gravity
-/// tilted by `tilt` (an incline of that angle), friction μ, through the patch.
+/// The slab on an incline (incline_fixture.hpp) held through the patch with friction μ.
 Vec3 slab_on_incline(double tilt, double mu) {
-  const Avatar a = box(6, 6, 0.01);
-  ModelOptions mo;
-  mo.h = kH;
-  mo.gravity = 9.81 * Vec3(std::sin(tilt), -std::cos(tilt), 0);
-  mo.newton.iterations = 4;
-  mo.newton.line_search = true;
-  ModelBuilder mb(mo);
-  const int body = mb.add_body({"box", std::make_shared<const Avatar>(a), false});
-  const int slab = mb.add_body({"slab", nullptr, true});
-  add_soft_tissue_terms(mb, body, {true, 0.0});
-  const double m = 0.1;
-  const Vec3 half(0.06, 0.005, 0.06);  // wider than the top: no sample meets its sides
-  add_rigid_body_terms(mb, slab, m, m / 3 * Vec3(half.y() * half.y() + half.z() * half.z(),
-                                                 half.x() * half.x() + half.z() * half.z(),
-                                                 half.x() * half.x() + half.y() * half.y()).asDiagonal().toDenseMatrix());
-  ContactPatchOptions o;
-  o.pressure_stiffness = 1.0e8;
-  o.spacing = 0.005;
-  o.patch_radius = 0.015;
-  o.friction = mu;
-  mb.add_term(std::make_shared<const ContactPatchTerm>("slab", a, std::make_shared<geometry::BoxSdf>(half),
-                                                       Isometry::Identity(), true, o),
-              {body, slab});
-  Simulator sim(mb.build());
-  State s = sim.scene_state();
-  const Vec3 start(0, 0.03 + half.y() - 0.0001, 0);
-  s.bodies[slab].q.bones[0].translation() = start;
-  s.bodies[slab].q_prev = s.bodies[slab].q;
-  sim.set_state(s);
-  StepInputs in;
-  in.bodies.resize(2);
-  in.bodies[body].bones = identity_bones();
-  for (int i = 0; i < 60; ++i) sim.step(in);
-  return sim.state(slab).bones[0].translation() - start;
+  return test::slab_on_incline(tilt, [mu](const Avatar& a, const Vec3& half) {
+    ContactPatchOptions o;
+    o.pressure_stiffness = 1.0e8;
+    o.spacing = 0.005;
+    o.patch_radius = 0.015;
+    o.friction = mu;
+    return std::make_shared<const ContactPatchTerm>("slab", a, std::make_shared<geometry::BoxSdf>(half),
+                                                    Isometry::Identity(), true, o);
+  });
 }
 
 TEST(ContactPatchFriction, FrictionHoldsASlabOnAnInclineBelowItsFrictionAngleOnly) {

@@ -21,6 +21,7 @@
 #include "sflsh/sim/soft_tissue_terms.hpp"
 #include "sim/skeleton_fixture.hpp"
 #include "sim/synthetic_avatar.hpp"
+#include "sim/incline_fixture.hpp"
 #include "sim/two_body_fixture.hpp"
 #include "test_support.hpp"
 
@@ -599,43 +600,16 @@ TEST(ContactScene, ABallRestingOnAKinematicBodyIsHeldByItsWeight) {
   EXPECT_LT(v.norm(), 1e-3) << "the ball has not come to rest";
 }
 
-/// Where a dynamic slab resting on the flat top of a kinematic box ends after
-/// 1 s with gravity tilted by `tilt` rad (an incline of that angle) and friction μ.
+/// The slab on an incline (incline_fixture.hpp) held by the per-sample penalty with friction μ.
 Vec3 slab_on_incline(double tilt, double mu) {
-  const Avatar a = box(6, 6, 0.01);  // 6 cm top at y = 0.03, vertices 1 cm apart
-  ModelOptions mo;
-  mo.h = kH;
-  mo.gravity = 9.81 * Vec3(std::sin(tilt), -std::cos(tilt), 0);
-  mo.newton.iterations = 4;
-  mo.newton.line_search = true;
-  ModelBuilder mb(mo);
-  const int body = mb.add_body({"box", std::make_shared<const Avatar>(a), false});
-  const int slab = mb.add_body({"slab", nullptr, true});
-  add_soft_tissue_terms(mb, body, {true, 0.0});
-  const double m = 0.1;
-  // Wider than the top, so that no skin sample meets its side faces before it
-  // has slid 3 cm (a sample at a face edge would hook the slab).
-  const Vec3 half(0.06, 0.005, 0.06);
-  add_rigid_body_terms(mb, slab, m, m / 3 * Vec3(half.y() * half.y() + half.z() * half.z(),
-                                                 half.x() * half.x() + half.z() * half.z(),
-                                                 half.x() * half.x() + half.y() * half.y()).asDiagonal().toDenseMatrix());
-  SdfContactOptions co;
-  co.stiffness = 2.0e5;
-  co.friction = mu;
-  mb.add_term(std::make_shared<const SdfContactTerm>("slab", PosedPoints::at_surface(a),
-                                                     std::make_shared<geometry::BoxSdf>(half), Isometry::Identity(), true,
-                                                     co),
-              {body, slab});
-  Simulator sim(mb.build());
-  State s = sim.scene_state();
-  s.bodies[slab].q.bones[0].translation() = Vec3(0, 0.03 + half.y() - 0.0002, 0);
-  s.bodies[slab].q_prev = s.bodies[slab].q;
-  sim.set_state(s);
-  StepInputs in;
-  in.bodies.resize(2);
-  in.bodies[body].bones = identity_bones();
-  for (int i = 0; i < 60; ++i) sim.step(in);
-  return sim.state(slab).bones[0].translation() - Vec3(0, 0.03 + half.y() - 0.0002, 0);
+  return test::slab_on_incline(tilt, [mu](const Avatar& a, const Vec3& half) {
+    SdfContactOptions co;
+    co.stiffness = 2.0e5;
+    co.friction = mu;
+    return std::make_shared<const SdfContactTerm>("slab", PosedPoints::at_surface(a),
+                                                  std::make_shared<geometry::BoxSdf>(half), Isometry::Identity(), true,
+                                                  co);
+  });
 }
 
 TEST(ContactScene, FrictionHoldsASlabOnAnInclineAboveTheFrictionAngleOnly) {
