@@ -77,6 +77,91 @@ struct ReferenceGrasp {
   size_t first = 0, count = 0;  // its anchors in the step's FullFemAnchor list
 };
 
+/// Adds the scene's obstacles in contact with the body to `fem`: the result
+/// header's objects (objects, then tools with a shape). Returns each
+/// obstacle's index into r.objects.
+std::vector<int> add_obstacles(const SceneDescription& sc, const std::string& body_name, const SimulationResult& r,
+                               FullFem& fem) {
+  std::vector<int> obstacle_object;
+  auto add = [&](const std::string& name, const ShapeDescription& shape, ObjectKind kind) {
+    if (!collides(sc.contact, body_name, name)) return;
+    RigidObjectDescription d;
+    d.name = name;
+    d.shape = shape;
+    d.kind = kind;
+    FullFemObstacle ob{name, make_rigid_object(d).field, sc.contact.pressure_stiffness,
+                       sc.contact.patch_spacing};
+    fem.add_obstacle(std::move(ob));
+    for (size_t i = 0; i < r.objects.size(); ++i)
+      if (r.objects[i].name == name) obstacle_object.push_back(int(i));
+    require(obstacle_object.size() == size_t(fem.num_obstacles()), name, ": not in the result's objects");
+  };
+  for (const RigidObjectDescription& o : sc.objects) add(o.name, o.shape, o.kind);
+  for (const ToolDescription& t : sc.tools)
+    if (t.has_shape) add(t.name, t.shape, ObjectKind::Kinematic);
+  return obstacle_object;
+}
+
+/// The grasping tools on the reference's own skin over the step from t0:
+/// each tool's grasp by the reduced run's rule at its device pose at t0
+/// (`before`; the session has stepped to t0 + h), its anchors set on `fem`,
+/// its grasp and release events appended to `events`.
+void grasp_reference_skin(const SceneSession& session, const std::vector<teleop::PoseSample>& before, double t0,
+                          std::vector<ReferenceGrasp>& grasps, FullFem& fem, std::vector<ToolEvent>& events) {
+  const double h = session.dt();
+  const std::string& body_name = session.body_name(0);
+  const Simulator& sim = session.simulator();
+  const int body = session.body_model_index(0);
+  std::vector<FullFemAnchor> anchors;
+  Points skin;  // the reference's skin at t, while a tool looks for something to grasp
+  std::vector<AnchorPoint> points;
+  for (size_t g = 0; g < grasps.size(); ++g) {
+    ReferenceGrasp& rg = grasps[g];
+    const teleop::PoseSample& now = before[g];
+    const teleop::PoseSample& next = session.tool_state(rg.tool).device;
+    const Isometry pose_now = pose_at(now.position, now.orientation);
+    if (rg.grasp.seeking(now.closure) && skin.size() == 0) skin = fem.skin_points(fem.displacement());
+    if (rg.grasp.update(t0, pose_now, now.closure, rg.grasp.seeking(now.closure) ? skin : Points(),
+                        sim.model().bodies()[size_t(body)].avatar->surface_faces)) {
+      const GraspEvent& ev = rg.grasp.log().back();
+      events.push_back({ev.time, session.tool_name(rg.tool), body_name,
+                        ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
+    }
+    anchor_points(frame_between(pose_now, pose_at(next.position, next.orientation), h), rg.grasp.anchors(), false,
+                  points);
+    rg.first = anchors.size();
+    rg.count = points.size();
+    for (const AnchorPoint& p : points)
+      anchors.push_back({p.point, p.position, p.position - h * p.velocity, rg.hardness, rg.damping});
+  }
+  fem.set_anchors(std::move(anchors));
+}
+
+/// One reference step's forces: on each tool its shape's contact reaction
+/// and its anchors' (`tool_forces`), each obstacle's contact into the
+/// statistics and the result's contact frames (`contacts`, drawn at `poses`).
+void collect_forces(const SceneSession& session, const FullFemReport& rep, const std::vector<ReferenceGrasp>& grasps,
+                    const std::vector<Isometry>& poses, std::vector<Vec3>& tool_forces, SceneContactStats& st,
+                    std::vector<ContactFrame>& contacts) {
+  for (int i = 0; i < session.num_tools(); ++i) {
+    Vec3 f = Vec3::Zero();
+    for (size_t o = 0; o < rep.contacts.size(); ++o)
+      if (rep.contacts[o].name == session.tool_name(i)) f -= rep.contacts[o].force;
+    tool_forces[size_t(i)] = f;
+  }
+  for (const ReferenceGrasp& g : grasps)
+    for (size_t i = g.first; i < g.first + g.count; ++i) tool_forces[size_t(g.tool)] -= rep.anchor_forces.at(i);
+  for (size_t i = 0; i < rep.contacts.size(); ++i) {
+    SceneContactStats::Pair& p = st.pairs[i];
+    const FullFemContact& c = rep.contacts[i];
+    p.last_force = c.force;
+    p.max_force = std::max(p.max_force, c.force.norm());
+    p.max_penetration = std::max(p.max_penetration, c.max_penetration);
+    if (c.active_samples > 0) ++p.active_steps;
+    contacts[i] = {c.force, poses.at(i).translation(), c.max_penetration, c.active_samples};
+  }
+}
+
 }  // namespace
 
 SimulationResult run_scene_reference(const SceneDescription& scene, const SceneReferenceOptions& opt,
@@ -96,25 +181,8 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
   FullFem fem(sim.model().bodies()[size_t(body)].avatar, fo);
   fem.reset(sim.state(body).bones);
 
-  // Obstacles: the result header's objects (objects, then tools with a shape), those in contact with the body.
   SimulationResult r = session.result_header();
-  std::vector<int> obstacle_object;  // index into r.objects per obstacle
-  auto add = [&](const std::string& name, const ShapeDescription& shape, ObjectKind kind) {
-    if (!collides(sc.contact, body_name, name)) return;
-    RigidObjectDescription d;
-    d.name = name;
-    d.shape = shape;
-    d.kind = kind;
-    FullFemObstacle ob{name, make_rigid_object(d).field, sc.contact.pressure_stiffness,
-                       sc.contact.patch_spacing};
-    fem.add_obstacle(std::move(ob));
-    for (size_t i = 0; i < r.objects.size(); ++i)
-      if (r.objects[i].name == name) obstacle_object.push_back(int(i));
-    require(obstacle_object.size() == size_t(fem.num_obstacles()), name, ": not in the result's objects");
-  };
-  for (const RigidObjectDescription& o : sc.objects) add(o.name, o.shape, o.kind);
-  for (const ToolDescription& t : sc.tools)
-    if (t.has_shape) add(t.name, t.shape, ObjectKind::Kinematic);
+  const std::vector<int> obstacle_object = add_obstacles(sc, body_name, r, fem);
 
   std::vector<ReferenceGrasp> grasps;
   for (int i = 0; i < session.num_tools(); ++i) {
@@ -162,32 +230,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     std::vector<teleop::PoseSample> before;
     for (const ReferenceGrasp& g : grasps) before.push_back(session.tool_state(g.tool).device);
     session.advance();
-    if (!grasps.empty()) {
-      const double h = session.dt(), t0 = double(k) * h;
-      std::vector<FullFemAnchor> anchors;
-      Points skin;  // the reference's skin at t, while a tool looks for something to grasp
-      std::vector<AnchorPoint> points;
-      for (size_t g = 0; g < grasps.size(); ++g) {
-        ReferenceGrasp& rg = grasps[g];
-        const teleop::PoseSample& now = before[g];
-        const teleop::PoseSample& next = session.tool_state(rg.tool).device;
-        const Isometry pose_now = pose_at(now.position, now.orientation);
-        if (rg.grasp.seeking(now.closure) && skin.size() == 0) skin = fem.skin_points(fem.displacement());
-        if (rg.grasp.update(t0, pose_now, now.closure, rg.grasp.seeking(now.closure) ? skin : Points(),
-                            sim.model().bodies()[size_t(body)].avatar->surface_faces)) {
-          const GraspEvent& ev = rg.grasp.log().back();
-          tool_events.push_back({ev.time, session.tool_name(rg.tool), body_name,
-                                 ev.kind == GraspEvent::Kind::Grasp ? "grasp" : "release", int(ev.points.size())});
-        }
-        anchor_points(frame_between(pose_now, pose_at(next.position, next.orientation), h), rg.grasp.anchors(), false,
-                      points);
-        rg.first = anchors.size();
-        rg.count = points.size();
-        for (const AnchorPoint& p : points)
-          anchors.push_back({p.point, p.position, p.position - h * p.velocity, rg.hardness, rg.damping});
-      }
-      fem.set_anchors(std::move(anchors));
-    }
+    if (!grasps.empty()) grasp_reference_skin(session, before, double(k) * session.dt(), grasps, fem, tool_events);
     const std::vector<Isometry> all = session.object_poses();
     std::vector<Isometry> poses;
     for (int i : obstacle_object) poses.push_back(all.at(size_t(i)));
@@ -196,24 +239,7 @@ SimulationResult run_scene_reference(const SceneDescription& scene, const SceneR
     const double cpu_ms = thread_cpu_ms() - cpu0;
     const double t = (k + 1) * session.dt();
     if (!rep.converged) ++not_converged;
-    // On each tool: its shape's contact reaction and its anchors'.
-    for (int i = 0; i < session.num_tools(); ++i) {
-      Vec3 f = Vec3::Zero();
-      for (size_t o = 0; o < rep.contacts.size(); ++o)
-        if (rep.contacts[o].name == session.tool_name(i)) f -= rep.contacts[o].force;
-      tool_forces[size_t(i)] = f;
-    }
-    for (const ReferenceGrasp& g : grasps)
-      for (size_t i = g.first; i < g.first + g.count; ++i) tool_forces[size_t(g.tool)] -= rep.anchor_forces.at(i);
-    for (size_t i = 0; i < rep.contacts.size(); ++i) {
-      SceneContactStats::Pair& p = st.pairs[i];
-      const FullFemContact& c = rep.contacts[i];
-      p.last_force = c.force;
-      p.max_force = std::max(p.max_force, c.force.norm());
-      p.max_penetration = std::max(p.max_penetration, c.max_penetration);
-      if (c.active_samples > 0) ++p.active_steps;
-      contacts[i] = {c.force, poses.at(i).translation(), c.max_penetration, c.active_samples};
-    }
+    collect_forces(session, rep, grasps, poses, tool_forces, st, contacts);
     StepReport sr;  // Newton to convergence: each step counts as accepted (non-converged ones are warned about)
     sr.accepted = 1;
     sr.iterations = rep.iterations;

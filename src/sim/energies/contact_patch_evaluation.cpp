@@ -353,38 +353,38 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
     std::array<std::array<Mat3, 3>, 3> M;
     for (auto& row : M) row.fill(Mat3::Zero());
     bool touching = false;
+    // A sample's gradient gs = ∂E/∂x and Hessian H into the face's
+    // accumulators, and against a dynamic object whose point there is y.
+    auto add_sample = [&](const SkinFaceSample& smp, const Vec3& gs, const Mat3& H, const Vec3& y) {
+      touching = true;
+      for (int i = 0; i < 3; ++i) {
+        g[i] += smp.lambda[i] * gs;
+        if (out.has_Hpp)
+          for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
+      }
+      if (ob < 0 || !q_derivatives) return;
+      Mat63 JoT;  // J_oᵀ
+      JoT << hat(y), Mat3::Identity();
+      out.gq.segment<6>(ob) -= JoT * gs;
+      if (!q_hessian) return;
+      out.Hqq.block<6, 6>(ob, ob) += JoT * H * JoT.transpose();
+      for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
+    };
     for (int s = c.face_first[fi]; s < c.face_first[fi + 1]; ++s) {
       const SkinFaceSample& smp = c.samples[s];
       const Vec3 x = smp.lambda[0] * xv[vs[0]] + smp.lambda[1] * xv[vs[1]] + smp.lambda[2] * xv[vs[2]];
       if (friction && c.friction_bound[s] > 0) {
-        // Friction against the point the object carries (header comment, "Friction").
+        // Friction against the point y the object carries (header comment, "Friction").
         const Vec3 y = dynamic_ ? Vec3(carry * c.friction_point[s]) : c.friction_point[s];
         const contact_friction::PointFriction f =
             contact_friction::point_friction(x, y, c.friction_normal[s], c.friction_bound[s], eps, true);
         E += f.energy;
         out.force -= f.gradient;
         out.friction_force -= f.gradient;
-        if (p_derivatives) {
-          touching = true;
-          for (int i = 0; i < 3; ++i) {
-            g[i] += smp.lambda[i] * f.gradient;
-            if (out.has_Hpp)
-              for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * f.hessian;
-          }
-          if (ob >= 0 && q_derivatives) {
-            Mat63 JoT;  // J_oᵀ at the object's point y
-            JoT << hat(y), Mat3::Identity();
-            out.gq.segment<6>(ob) -= JoT * f.gradient;
-            if (q_hessian) {
-              out.Hqq.block<6, 6>(ob, ob) += JoT * f.hessian * JoT.transpose();
-              for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * f.hessian);
-            }
-          }
-        }
+        if (p_derivatives) add_sample(smp, f.gradient, f.hessian, y);
       }
       const geometry::SdfSample sd = field_->evaluate(T_inv * x);
       if (!(sd.distance < 0)) continue;
-      touching = p_derivatives;
       const double k = kappa * smp.area, d = sd.distance;
       const Vec3 nrm = T.linear() * sd.gradient;
       E += 0.5 * k * d * d;
@@ -394,21 +394,8 @@ double ContactPatchTerm::add_patch_contact(const StepContext& ctx, const Configu
       ++out.active;
       out.depth = std::max(out.depth, -d);
       out.area += smp.area;
-      if (!p_derivatives) continue;
-      const Mat3 H = k * nrm * nrm.transpose();
-      for (int i = 0; i < 3; ++i) {
-        g[i] += smp.lambda[i] * k * d * nrm;
-        if (out.has_Hpp)
-          for (int j = 0; j < 3; ++j) M[i][j] += smp.lambda[i] * smp.lambda[j] * H;
-      }
-      if (ob < 0 || !q_derivatives) continue;
-      Mat63 JoT;  // J_oᵀ
-      JoT << hat(x), Mat3::Identity();
-      const Vec3 gs = k * d * nrm;
-      out.gq.segment<6>(ob) -= JoT * gs;
-      if (!q_hessian) continue;
-      out.Hqq.block<6, 6>(ob, ob) += JoT * H * JoT.transpose();
-      for (int i = 0; i < 3; ++i) Nv[vs[i]] -= smp.lambda[i] * (JoT * H);
+      // The object's point at x itself.
+      if (p_derivatives) add_sample(smp, k * d * nrm, k * nrm * nrm.transpose(), x);
     }
     if (!touching) continue;
     for (int i = 0; i < 3; ++i) {
