@@ -11,7 +11,9 @@
     a pinch at 1 kHz from the other: frames behind (a frame whose substeps
     were clamped: the machine did not keep up; the RTF itself is ~1 by
     construction of the clock-paced loop), step time, feedback latency (pose
-    sent -> force received, median and p99);
+    sent -> force received, median and p99); the same for a coupled 1 cm
+    probe pressing 10 mm into the belly through its patch
+    (apps/scenes/teleop_probe.yaml), with its largest force on the device;
   * abuse, 10,000 steps each: the gripper yanked at 5 m/s while grasping
     (figures/yank_belly.yaml); anchors of hardness 1e5 N/m pinching 8 times;
     a live stream with 10 % dropped and 1 % malformed datagrams. Each: no
@@ -76,6 +78,17 @@ def pinch_cycles(path, cycles, period=PERIOD):
                 f.write(f"{t0 + dt:.6f},0,1.05,{z},1,0,0,0,{cl}\n")
 
 
+def probe_cycles(path, cycles, period=PERIOD):
+    """A pose file pressing the 1 cm probe of teleop_probe.yaml from 5 mm in front of the belly's skin
+    (z = 0.107 m) to 10 mm into it over 1 s, holding 0.5 s and withdrawing over 1 s, every `period` s."""
+    with open(path, "w") as f:
+        f.write("time,x,y,z,qw,qx,qy,qz,closure\n")
+        for c in range(cycles):
+            for dt, z in ((0.0, 0.117), (1.0, 0.102), (1.5, 0.102)):
+                f.write(f"{c * period + dt:.6f},0,1.05,{z},1,0,0,0,0\n")
+        f.write(f"{cycles * period:.6f},0,1.05,0.117,1,0,0,0,0\n")
+
+
 def stream_run(work, scene, seconds, poses, name, extra=(), count=None):
     """`sflsh run --realtime` on core 0 and the replay client on core 1; keeps NAME.log (the run's stdout),
     NAME_live.csv (its tool log) and NAME_replay.json (the client's summary) in `work`."""
@@ -100,7 +113,7 @@ def measure(work):
     if not os.path.exists(os.path.join(work, "avatar.h5")):
         run([SFLSH, "precompute", "--out", "avatar.h5"], work, "precompute.log")
     for f in ("figures/pinch_coupled.yaml", "figures/yank_belly.yaml", "figures/yank.csv", "figures/pinch.csv",
-              "teleop_pinch.yaml"):
+              "teleop_pinch.yaml", "teleop_probe.yaml"):
         shutil.copy(os.path.join(ROOT, "apps/scenes", f), work)
     run([SFLSH, "run", "pinch_coupled.yaml", "--tool-log", "pinch_coupled_tools.csv", "--out", "pinch_coupled.h5",
          "--quiet-status"], work, "pinch_coupled.log")
@@ -117,6 +130,8 @@ def measure(work):
 
     pinch_cycles(os.path.join(work, "pinch_cycles.csv"), CYCLES)
     stream_run(work, "teleop_pinch.yaml", 8, "pinch_cycles.csv", "realtime")
+    probe_cycles(os.path.join(work, "probe_cycles.csv"), 3)
+    stream_run(work, "teleop_probe.yaml", 8, "probe_cycles.csv", "probe_realtime")
 
     run([SFLSH, "run", "yank_belly.yaml", "--tool-log", "yank_tools.csv", "--quiet-status"], work, "yank_belly.log")
 
@@ -246,6 +261,16 @@ def judge(work):
     row("  … latency pose sent → force received: median / p99", "(record)",
         f"{rep['latency_median_ms']:.3f} / {rep['latency_p99_ms']:.3f} ms (max {rep['latency_max_ms']:.1f} ms)", None,
         "teleop_pinch.yaml")
+    s = summary(w("probe_realtime.log"))
+    if s["behind"] is None:
+        raise BadResults(f"{w('probe_realtime.log')}: no 'N behind' (a --realtime run's summary)")
+    L = tool_log(w("probe_realtime_live.csv"))
+    force = np.sqrt(L["force_x"] ** 2 + L["force_y"] ** 2 + L["force_z"] ** 2)
+    row("real time: one avatar + a coupled 1 cm probe pressing 10 mm into the belly through its patch, 500 Hz, one "
+        "core: frames behind", "0 (RTF 1)", f"{s['behind']} (RTF {s['rtf']:.3f}; step median {s['median_ms']:.2f} ms, "
+        f"p99 {s['p99_ms']:.2f} ms)", s["behind"] == 0 and tool_log_finite(L), "teleop_probe.yaml")
+    row("  … largest force on the probe (`probe_realtime_live.csv`)", "(record)", f"{force.max():.2f} N", None,
+        "teleop_probe.yaml")
 
     # Abuse, 10,000 steps each.
     s = summary(w("yank_belly.log"))

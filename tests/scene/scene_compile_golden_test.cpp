@@ -239,6 +239,15 @@ TEST_F(SceneCompileGolden, TeleopPinch) {
           {9.4540000000000006, 0, 0, 0, 3.2540000000000004, 0, 0}, 0}});
 }
 
+TEST_F(SceneCompileGolden, TeleopProbe) {
+  check({"teleop_probe.yaml", at_belly, 5,
+         {"inertia@0; elastic@0; gravity@0; bone_inertia@1; coupling:probe@1; contact:probe@0,1",
+          "alice:0/24/18@0 probe:1/1/0@18 dofs 24 blocks 2 groups 1",
+          {0.002, 693, 2100, -0.00050056439948294629, 5.9038193884272798e-08, 693, 2100, 0, 0, 4.9020000000000001, 14, 0, 0, 4.9020000000000001, 14, 0, 0},
+          {0.01, 693, 2100, -0.0025206237706706268, 2.9873370981073952e-06, 693, 2100, -0.0021856926477913591, 1.7559522919779889e-06, 4.9020000000000001, 14, 0, 0, 4.9020000000000001, 14, 0, 0},
+          {9.4510000000000005, 0, 0, 0, 2.4510000000000001, 9.4510000000000005, 0}, 0}});
+}
+
 // Two bodies meet skin against skin (skin_contact@0,1) with the bone
 // capsules as cores (body_contact@0,1): the states re-pinned when that became
 // the default body-body contact (an intended change of the physics), and
@@ -456,5 +465,5 @@ TEST_F(SceneCompileGolden, CoversEveryExampleScene) {
   for (const char* dir : {"apps/scenes", "apps/scenes/figures"})
     for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(test::source_dir()) / dir))
       scenes += e.path().extension() == ".yaml";
-  EXPECT_EQ(scenes, 17) << "a new example scene: add it to SceneCompileGolden";
+  EXPECT_EQ(scenes, 18) << "a new example scene: add it to SceneCompileGolden";
 }

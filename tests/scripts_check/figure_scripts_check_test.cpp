@@ -82,12 +82,13 @@ std::string name_of(const ::testing::TestParamInfo<Case>& info) {
 INSTANTIATE_TEST_SUITE_P(
     Teleop, FigureScriptCheck,
     ::testing::Values(
-        Case{"teleop", "good", 0, {"| 0 (RTF 1.000;", "66.6 J / 64.0 J"}},
+        Case{"teleop", "good", 0, {"| 0 (RTF 1.000;", "66.6 J / 64.0 J", "| 2.50 N |"}},
         Case{"teleop", "pinch_slips", 1, {"target missed: pinch-and-lift", "2.80 mm"}},
         Case{"teleop", "pinch_no_return", 1, {"target missed: skin against the same run", "/ 0.70 / 1.20 mm"}},
         Case{"teleop", "pinch_ends_early", 2, {"pinch_coupled.h5: the run ends 1.13 s after the release"}},
         Case{"teleop", "pinch_nan", 1, {"target missed: grasp / release", ", NaN (target"}},
         Case{"teleop", "realtime_behind", 1, {"target missed: real time", "frames behind: 3 (RTF 1.000"}},
+        Case{"teleop", "probe_behind", 1, {"target missed: real time: one avatar + a coupled 1 cm probe", "2 (RTF 1.000"}},
         Case{"teleop", "yank_energy_grows", 1, {"target missed: abuse: gripper yanked", "84.0 J"}},
         Case{"teleop", "yank_nan", 1, {"target missed: abuse: gripper yanked", "10000, NaN, 0"}},
         Case{"teleop", "hard_energy_grows", 1, {"target missed: abuse: anchors of hardness", "1.08 / 1.50 J"}},

@@ -95,6 +95,12 @@ def teleop(variant, d):
                latency_p99_ms=1.162, latency_max_ms=4.9)
     if variant != "realtime_no_replay":
         write(p("realtime_replay.json"), json.dumps(rep))
+    # The coupled probe in real time, 8 s at 500 Hz.
+    behind = 2 if variant == "probe_behind" else 0
+    write(p("probe_realtime.log"), f"real time: simulated 8.000 s in 8.001 s of wall time (4000 steps), RTF 1.000; "
+          f"240 frames, {behind} behind (clamped at max substeps, 0.000 s dropped)\n" + steps_line(4000))
+    t = np.arange(0, 8.0001, 0.01)
+    tool_csv(p("probe_realtime_live.csv"), t, 0.01 * np.ones_like(t), 0 * t, 0 * t, force=2.5)
 
     # Yank, 20 s: the energy rises to 66.6 J during the yank and stays near 64 J.
     t = np.arange(0, 20.0001, 0.05)
