@@ -89,11 +89,14 @@ if [ "$QUICK" = 1 ]; then WORK="$OUT/work"; else WORK="$REPO/out/reproduce"; fi
 mkdir -p "$WORK/logs" || exit 2
 MODE=""; [ "$QUICK" = 1 ] && MODE=" --quick"
 
-# The commit, and "dirty" when tracked files differ from it (untracked files are not looked at).
+# The commit, and "dirty" when tracked files differ from it (untracked files are not looked at, nor
+# scripts/results: the tables a step writes there would make the step's own later stamps dirty).
 git_state() {
   local c
   c=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-  if ! git diff --quiet HEAD -- 2>/dev/null; then c="$c (dirty: tracked files differ from it)"; fi
+  if ! git diff --quiet HEAD -- . ':(exclude)scripts/results' 2>/dev/null; then
+    c="$c (dirty: tracked files differ from it)"
+  fi
   echo "$c"
 }
 COMMIT=$(git_state)
