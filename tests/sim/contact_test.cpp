@@ -13,6 +13,7 @@
 #include "sflsh/core/rotation.hpp"
 #include "sflsh/geometry/primitive_sdfs.hpp"
 #include "sflsh/sim/energies/capsule_contact.hpp"
+#include "sflsh/sim/energies/contact_patch.hpp"
 #include "sflsh/sim/energies/sdf_contact.hpp"
 #include "sflsh/sim/momentum.hpp"
 #include "sflsh/sim/rigid_body_terms.hpp"
@@ -327,6 +328,46 @@ TEST(SdfContact, SampleSpacingKeepsOneVertexPerCell) {
       if (Vec3((y / 0.08).array().floor()) != cell) continue;
       EXPECT_LE((x - centre).norm(), (y - centre).norm() + 1e-15) << "sample " << p << " vs vertex " << v;
     }
+  }
+}
+
+TEST(SdfContact, AMovingShapeFrameMovesTheShapeAndANonFiniteOneIsRefusedNamingIt) {
+  // A dynamic lid whose shape the inputs move 2 cm up on its body (a jaw
+  // opening): pressed 4 mm into the box's top by its body pose, the moved
+  // shape no longer touches. Both contact models read the frame the same way.
+  const Avatar a = box();
+  auto cube = std::make_shared<geometry::BoxSdf>(Vec3(0.05, 0.02, 0.05));
+  std::vector<Bound> bodies{{&a, body_layout(a, false), {}, {}, {}}, {nullptr, rigid_layout(0), {}, {}, {}}};
+  bodies[1].layout.base = bodies[0].layout.size();
+  bodies[0].q.bones = identity_bones();
+  bodies[0].q.z = VecX::Zero(a.num_reduced());
+  bodies[0].q_prev = bodies[0].q_prev2 = bodies[0].q;
+  Isometry G = Isometry::Identity();
+  G.translation() = Vec3(0.0, 0.12 + 0.02 - 0.004, 0.0);
+  bodies[1].q.bones = {G};
+  bodies[1].q.z = VecX(0);
+  bodies[1].q_prev = bodies[1].q_prev2 = bodies[1].q;
+  const SdfContactTerm sdf("lid", PosedPoints::at_surface(a), cube, Isometry::Identity(), true);
+  ContactPatchOptions po;
+  po.patch = false;
+  const ContactPatchTerm patch("lid", a, cube, Isometry::Identity(), true, po);
+  for (const EnergyTerm* term : {static_cast<const EnergyTerm*>(&sdf), static_cast<const EnergyTerm*>(&patch)}) {
+    ASSERT_EQ(term->input_frames(), std::vector<std::string>{"lid/shape"});
+    std::map<std::string, WorldFrame> frames;
+    {
+      StepContext ctx = bind_bodies(bodies, nullptr);  // no frame: the shape where the body puts it
+      auto cache = begin_term_step(*term, ctx);
+      EXPECT_GT(term->evaluate(ctx, bodies[0].q, nullptr, nullptr), 0) << term->name();
+    }
+    frames["lid/shape"].pose = G * Isometry(Eigen::Translation3d(0, 0.02, 0));
+    {
+      StepContext ctx = bind_bodies(bodies, &frames);
+      auto cache = begin_term_step(*term, ctx);
+      EXPECT_EQ(term->evaluate(ctx, bodies[0].q, nullptr, nullptr), 0) << term->name();
+    }
+    frames["lid/shape"].pose.translation().x() = NAN;
+    StepContext ctx = bind_bodies(bodies, &frames);
+    test::expect_error([&] { begin_term_step(*term, ctx); }, {"contact:lid", "'lid/shape'", "not finite"});
   }
 }
 

@@ -29,14 +29,8 @@ void ContactPatchTerm::find_near_vertices(const StepContext& ctx, TermCache& cac
     require(ctx.bound.size() == 2 && ctx.bound[1].q_prev != nullptr, name(),
             ": a dynamic object's contact is bound to the body and the object");
     const Isometry& G = ctx.bound[1].q_prev->bones[0];
-    c.shape_in_frame = shape_in_frame_;
-    if (const WorldFrame* f = ctx.frame()) {
-      // A shape that moves on its body (a gripper's jaw): its pose for this
-      // step, given in the world relative to the body's pose at t.
-      require(f->pose.matrix().allFinite(), name(), ": world frame '", moving_shape_frame_name(object_),
-              "' is not finite");
-      c.shape_in_frame = G.inverse() * f->pose;
-    }
+    // A shape that moves on its body (a gripper's jaw): its pose for this step.
+    c.shape_in_frame = step_shape_in_frame(ctx.frame(), G, shape_in_frame_, name(), object_);
     c.field_pose = G * c.shape_in_frame;
     if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
       const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];

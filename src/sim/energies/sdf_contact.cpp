@@ -83,6 +83,13 @@ Isometry SdfContactTerm::field_pose(const StepContext& ctx) const {
 
 std::string moving_shape_frame_name(const std::string& object) { return object + "/shape"; }
 
+Isometry step_shape_in_frame(const WorldFrame* f, const Isometry& body_t, const Isometry& fixed,
+                             const std::string& term, const std::string& object) {
+  if (!f) return fixed;
+  require(f->pose.matrix().allFinite(), term, ": world frame '", moving_shape_frame_name(object), "' is not finite");
+  return body_t.inverse() * f->pose;
+}
+
 std::vector<std::string> SdfContactTerm::input_frames() const {
   return {dynamic_ ? moving_shape_frame_name(object_) : object_};
 }
@@ -99,14 +106,8 @@ void SdfContactTerm::begin_step(const StepContext& ctx) const {
   if (dynamic_) {
     require(ctx.bound.size() == 2, name(), ": a dynamic object's contact is bound to the body and the object");
     const Isometry& G = ctx.bound[1].q_prev->bones[0];
-    c.shape_in_frame = shape_in_frame_;
-    if (const WorldFrame* f = ctx.frame()) {
-      // A shape that moves on its body (a gripper's jaw): its pose for this
-      // step, given in the world relative to the body's pose at t.
-      require(f->pose.matrix().allFinite(), name(), ": world frame '", moving_shape_frame_name(object_),
-              "' is not finite");
-      c.shape_in_frame = G.inverse() * f->pose;
-    }
+    // A shape that moves on its body (a gripper's jaw): its pose for this step.
+    c.shape_in_frame = step_shape_in_frame(ctx.frame(), G, shape_in_frame_, name(), object_);
     T = G * c.shape_in_frame;
     if (ctx.bound[1].q_prev2 && !ctx.bound[1].q_prev2->bones.empty()) {
       const Isometry& Gp = ctx.bound[1].q_prev2->bones[0];

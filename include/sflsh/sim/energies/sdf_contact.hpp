@@ -71,6 +71,12 @@ struct SdfContactOptions {
 
 /// "<object>/shape": the world frame giving a dynamic object's moving shape for a step (header).
 std::string moving_shape_frame_name(const std::string& object);
+/// A dynamic object's shape in its body frame for this step: the moving shape
+/// frame `f` (world, t + h) relative to the body's pose `body_t` at t when the
+/// inputs give it, else `fixed`. Throws one line naming `term` and the frame
+/// of `object` when it is not finite.
+Isometry step_shape_in_frame(const WorldFrame* f, const Isometry& body_t, const Isometry& fixed,
+                             const std::string& term, const std::string& object);
 
 class SdfContactTerm : public EnergyTerm {
  public:
